@@ -1,1 +1,148 @@
-// Placeholder
+#include "asperity/ensemble.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "asperity/orientation.hpp"
+#include "asperity/random.hpp"
+
+namespace asperity {
+
+std::string_view to_string(Mode m) { return m == Mode::fresh ? "fresh" : "fixed"; }
+
+Mode parse_mode(std::string_view s) {
+  if (s == "fresh") return Mode::fresh;
+  if (s == "fixed") return Mode::fixed;
+  throw std::invalid_argument("unknown mode '" + std::string(s) + "' (expected fresh or fixed)");
+}
+
+void validate(const EnsembleConfig& c) {
+  validate(c.sphere);
+  if (c.drops < 1) throw std::invalid_argument("drops must be >= 1, got 0");
+  if (c.drops > (std::uint64_t{1} << 31))
+    throw std::invalid_argument("drops must be <= 2^31, got " + std::to_string(c.drops));
+  if (c.mode == Mode::fixed) {
+    if (c.spheres < 1) throw std::invalid_argument("spheres must be >= 1, got 0");
+    if (c.drops % c.spheres != 0)
+      throw std::invalid_argument("drops (" + std::to_string(c.drops) + ") must be a multiple of spheres (" +
+                                  std::to_string(c.spheres) + ")");
+  }
+  if (c.threads < 0) throw std::invalid_argument("threads must be >= 0, got " + std::to_string(c.threads));
+}
+
+std::vector<Vec3> fresh_cap(std::uint64_t n, std::uint64_t drop, std::uint64_t seed, unsigned k) {
+  Stream s(seed, Purpose::fresh, drop);
+  const unsigned m = static_cast<unsigned>(std::min<std::uint64_t>(k, n));
+  std::vector<Vec3> cap;
+  cap.reserve(m);
+  double x = 0.0;  // X_(j) so far
+  for (unsigned j = 0; j < m; ++j) {
+    const double u = s.uniform(), v = s.uniform0();
+    // Minimum of n - j uniforms on (x, 1): x + (1 - x)(1 - u^(1/(n-j))); expm1/log keep it
+    // accurate when the cap is tiny (x ~ 1/N).
+    x = x + (1.0 - x) * -std::expm1(std::log(u) / static_cast<double>(n - j));
+    // Direction at polar angle theta from the SOUTH pole (-z): cos theta = 1 - 2x.
+    const double sin_t = 2.0 * std::sqrt(x * (1.0 - x));
+    const double phi = 2.0 * std::numbers::pi * v;
+    cap.emplace_back(sin_t * std::cos(phi), sin_t * std::sin(phi), -(1.0 - 2.0 * x));
+  }
+  return cap;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void resize(ContactSamples& s, std::size_t n) {
+  s.r_x.resize(n), s.r_y.resize(n), s.r_z.resize(n), s.r_xy.resize(n), s.gap.resize(n), s.core.resize(n);
+}
+
+void store(ContactSamples& s, std::size_t i, const Contact& c) {
+  s.r_x[i] = c.r.x(), s.r_y[i] = c.r.y(), s.r_z[i] = c.r.z(), s.r_xy[i] = c.r_xy;
+  s.gap[i] = c.gap, s.core[i] = c.core ? 1 : 0;
+}
+
+// Work is cut into fixed chunks so that progress can be reported; results land at their drop
+// index, so the chunking never changes a result.
+constexpr std::uint64_t kChunk = 4096;
+
+template <class Body>
+void for_chunks(std::uint64_t total, std::uint64_t offset, std::uint64_t grand_total, const Progress& progress,
+                Body body) {
+  const std::int64_t chunks = static_cast<std::int64_t>((total + kChunk - 1) / kChunk);
+  std::atomic<std::uint64_t> done{0};
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t c = 0; c < chunks; ++c) {
+    const std::uint64_t b = static_cast<std::uint64_t>(c) * kChunk, e = std::min(total, b + kChunk);
+    body(b, e);
+    const std::uint64_t now = done.fetch_add(e - b) + (e - b);
+    if (progress && omp_get_thread_num() == 0) progress(offset + now, grand_total);
+  }
+}
+
+}  // namespace
+
+ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& progress) {
+  validate(c);
+  if (c.threads > 0) omp_set_num_threads(c.threads);
+  ContactSamples s;
+  s.mode = c.mode;
+  resize(s, c.drops);
+  const double R = c.sphere.radius, a = c.sphere.asperity_radius;
+  const std::uint64_t n = c.sphere.asperities;
+
+  if (c.mode == Mode::fresh) {
+    s.batches = c.drops;
+    const auto t0 = Clock::now();
+    for_chunks(c.drops, 0, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
+      const Rotation identity = Rotation::Identity();  // a fresh random sphere needs no rotation
+      const Vec3 down(0, 0, -1);
+      for (std::uint64_t i = b; i < e; ++i) {
+        const auto cap = fresh_cap(n, i, c.seed);
+        const Nearest nn = brute_lowest(cap, down);
+        store(s, i, make_contact(nn, cap[nn.index], identity, R, a));
+      }
+    });
+    s.seconds_query = since(t0);
+  } else {
+    s.batches = c.spheres;
+    const std::uint64_t m = c.drops / c.spheres;
+    for (std::uint64_t k = 0; k < c.spheres; ++k) {
+      auto t0 = Clock::now();
+      const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
+      s.seconds_generate += since(t0);
+      t0 = Clock::now();
+      const auto index = make_contact_query(c.backend, body.centres);
+      s.seconds_index += since(t0);
+      s.index_bytes = index->memory_bytes();
+      t0 = Clock::now();
+      for_chunks(m, k * m, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
+        std::vector<Rotation> q(e - b);
+        std::vector<Vec3> d(e - b);
+        std::vector<Nearest> nn(e - b);
+        for (std::uint64_t j = b; j < e; ++j) {
+          Stream st(c.seed, Purpose::orientation, k * m + j);
+          q[j - b] = random_rotation(st);
+          d[j - b] = body_down(q[j - b]);
+        }
+        index->lowest(d, nn);
+        for (std::uint64_t j = b; j < e; ++j) {
+          const Nearest& r = nn[j - b];
+          store(s, k * m + j, make_contact(r, body.centres[r.index], q[j - b], R, a));
+        }
+      });
+      s.seconds_query += since(t0);
+    }
+  }
+  s.core_contacts = static_cast<std::uint64_t>(std::count(s.core.begin(), s.core.end(), std::uint8_t{1}));
+  return s;
+}
+
+}  // namespace asperity

@@ -1,1 +1,40 @@
-// Placeholder
+#include "asperity/scene.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace asperity {
+
+std::vector<std::string> preset_names() { return {"fig3", "fig3-fixed"}; }
+
+Scene preset(std::string_view name) {
+  Scene s;
+  s.ensemble.sphere = SphereParams{100000, 3e-3, 6.5e-7};
+  s.ensemble.drops = 1000000;
+  s.ensemble.seed = 1;
+  if (name == "fig3") {
+    s.name = "fig3";
+    s.ensemble.mode = Mode::fresh;
+    return s;
+  }
+  if (name == "fig3-fixed") {
+    // The same physics from explicit spheres: 100 spheres x 10^4 rotations.
+    s.name = "fig3-fixed";
+    s.ensemble.mode = Mode::fixed;
+    s.ensemble.spheres = 100;
+    s.ensemble.backend = Backend::grid;
+    return s;
+  }
+  std::string known;
+  for (const auto& p : preset_names()) known += (known.empty() ? "" : ", ") + p;
+  throw std::invalid_argument("unknown preset '" + std::string(name) + "' (known: " + known + ")");
+}
+
+void validate(const Scene& s) {
+  validate(s.ensemble);
+  if (!(s.alpha > 0 && s.alpha < 1))
+    throw std::invalid_argument("alpha must be in (0, 1), got " + std::to_string(s.alpha));
+  if (s.out.empty()) throw std::invalid_argument("out must not be empty");
+}
+
+}  // namespace asperity

@@ -1,0 +1,72 @@
+#pragma once
+// What a run found, as a value: per-quantity summaries, one entry per (quantity, law) test with a
+// verdict, core-contact counts and timings. Rendered as a table for people, as report.json for
+// tools (a versioned contract, see README), and as PNG figures.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "asperity/ensemble.hpp"
+#include "asperity/scene.hpp"
+#include "asperity/statistics.hpp"
+
+namespace asperity {
+
+inline constexpr int kReportSchemaVersion = 1;
+
+struct QuantityReport {
+  std::string name;  ///< "r_xy", "r_x", "r_y", "r_z"
+  Summary summary;   ///< SI units (metres)
+};
+
+struct TestReport {
+  std::string quantity;   ///< e.g. "r_xy"
+  std::string law;        ///< "eq14", "exact-sphere", "eq18"
+  std::string scope;      ///< "all" (every drop), "pooled" (fixed: all rotations), "one-per-sphere"
+  std::string statistic;  ///< "KS" or "binomial"
+  double D = 0;           ///< KS distance (NaN for a count test)
+  double p = 1;
+  std::uint64_t n = 0;
+  double predicted_mean = 0;  ///< mean of the quantity under the law (NaN if not applicable)
+  bool iid = true;            ///< whether the p-value's iid assumption holds for these samples
+  bool decisive = true;       ///< counts towards the exit status
+  std::string verdict;        ///< "accept", "reject", "quenched" (fixed: expected deviation), "n/a"
+  std::string note;
+};
+
+struct GeometryReport {
+  Scene scene;
+  std::uint64_t samples = 0;
+  std::uint64_t core_contacts = 0;
+  double core_probability = 0;        ///< exact, per drop
+  double core_probability_paper = 0;  ///< the paper's R* estimate
+  double gap_min = 0, gap_median = 0; ///< runner-up height gap [m]
+  double quenched_scale = 0;          ///< typical KS deviation of one sphere's own law (fixed)
+  std::string ensemble_note;
+  std::vector<QuantityReport> quantities;
+  std::vector<TestReport> tests;
+  std::vector<std::pair<std::string, double>> timings_s;
+  std::vector<std::string> plots;     ///< file names written in the output directory
+  std::size_t index_bytes = 0;
+
+  /// A decisive test rejected its law.
+  bool rejected() const;
+};
+
+/// Summaries and tests of a run. Sorts copies of the samples; O(n log n).
+GeometryReport analyse(const Scene& scene, const ContactSamples& s);
+
+/// The human-readable table (quantity | measured +- se | law | KS D | p | verdict).
+std::string format_table(const GeometryReport& r);
+
+/// Serialised report.json text.
+std::string to_json(const GeometryReport& r);
+
+/// Writes `text` to `file` atomically (temporary + rename): never a partial file.
+void write_file_atomic(const std::filesystem::path& file, const std::string& text);
+
+/// Writes the PNG figures of r_xy, r_x, r_y against their laws into `dir`; returns file names.
+std::vector<std::string> write_plots(const std::filesystem::path& dir, const Scene& scene, const ContactSamples& s);
+
+}  // namespace asperity

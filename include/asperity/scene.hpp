@@ -1,0 +1,30 @@
+#pragma once
+// A scene: everything one run of validate-geometry needs, with named presets that reproduce the
+// paper's figures. Every field is validated before any work starts.
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "asperity/ensemble.hpp"
+
+namespace asperity {
+
+struct Scene {
+  std::string name = "fig3";  ///< preset name, or "custom"
+  EnsembleConfig ensemble;
+  double alpha = 0.01;        ///< significance level of each test
+  bool plots = true;          ///< write PNG figures (needs gnuplot)
+  std::filesystem::path out = "asperity-out";
+};
+
+/// Names of the built-in presets.
+std::vector<std::string> preset_names();
+/// The scene of a preset; throws std::invalid_argument naming the value for an unknown name.
+/// fig3: the paper's Fig. 3 -- N = 1e5, R = 3 mm, a = 6.5e-7 m, fresh spheres, 1e6 drops.
+Scene preset(std::string_view name);
+
+/// Throws std::invalid_argument naming the offending field and value.
+void validate(const Scene& s);
+
+}  // namespace asperity
