@@ -60,6 +60,7 @@ Law eq14_rxy(std::uint64_t n, double R, double scale) {
   law.description = "Eq. 14: Rayleigh, flat cap + Poisson, sigma^2 = 1/(2 pi lambda)";
   law.cdf = [lam](double t) { return t <= 0 ? 0.0 : -std::expm1(-lam * pi * t * t); };
   law.pdf = [lam](double t) { return t < 0 ? 0.0 : 2.0 * pi * lam * t * std::exp(-lam * pi * t * t); };
+  law.mean = std::sqrt(pi / 2.0) / std::sqrt(2.0 * pi * lam);  // sigma sqrt(pi/2)
   return law;
 }
 
@@ -71,6 +72,10 @@ Law exact_sphere_rxy(std::uint64_t n, double R) {
   law.description = "exact finite-N law on the sphere: P(theta_min > theta) = ((1+cos theta)/2)^N";
   law.cdf = [e](double t) { return 1.0 - e.survival(t); };
   law.pdf = [e](double t) { return e.pdf(t); };
+  // E[r_xy] = int_0^R S(t) dt; S is negligible beyond ~12 sigma of the flat law for large N.
+  const double hi = std::min(R, 12.0 / std::sqrt(2.0 * pi * areal_density(n, R)));
+  law.mean = boost::math::quadrature::gauss_kronrod<double, 31>::integrate([e](double t) { return e.survival(t); }, 0.0,
+                                                                            hi, 10, 1e-12);
   return law;
 }
 
@@ -95,7 +100,7 @@ double rx_tail(const ExactRxy& e, double t) {
   // Beyond phi* = acos(t/R) the integrand vanishes: integrate on [0, phi*] only (no kink).
   const double phi_max = std::acos(t / e.R);
   auto f = [&](double phi) { return e.survival(t / std::cos(phi)); };
-  const double v = boost::math::quadrature::gauss_kronrod<double, 31>::integrate(f, 0.0, phi_max, 15, 1e-13);
+  const double v = boost::math::quadrature::gauss_kronrod<double, 31>::integrate(f, 0.0, phi_max, 8, 1e-12);
   return v / pi;
 }
 double rx_density(const ExactRxy& e, double t) {

@@ -20,6 +20,7 @@ struct Law {
   std::string description;  ///< one line for humans
   Cdf cdf;
   std::function<double(double)> pdf;
+  double mean = 0;          ///< expectation of the law [same unit as its variable]
 };
 
 /// lambda = N / (4 pi R^2) [1/m^2]
