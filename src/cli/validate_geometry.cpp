@@ -135,33 +135,38 @@ int main(int argc, char** argv) {
 
   Scene scene;
   try {
+    // Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
+    auto given = [&](const char* name) { return app.count(name) > 0; };
     scene = preset(preset_name);
     auto& e = scene.ensemble;
-    if (!asperities.empty()) e.sphere.asperities = parse_count("--asperities", asperities);
-    if (!radius.empty()) e.sphere.radius = parse_length("--radius", radius);
-    if (!asperity_radius.empty()) e.sphere.asperity_radius = parse_length("--asperity-radius", asperity_radius);
-    if (!drops.empty()) e.drops = parse_count("--drops", drops);
-    if (!spheres.empty()) e.spheres = parse_count("--spheres", spheres);
-    if (!seed.empty()) {
+    if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities);
+    if (given("--radius")) e.sphere.radius = parse_length("--radius", radius);
+    if (given("--asperity-radius")) e.sphere.asperity_radius = parse_length("--asperity-radius", asperity_radius);
+    if (given("--drops")) e.drops = parse_count("--drops", drops);
+    if (given("--spheres")) e.spheres = parse_count("--spheres", spheres);
+    if (given("--seed")) {
       std::size_t used = 0;
       try {
         e.seed = std::stoull(seed, &used);
       } catch (const std::exception&) {
         used = 0;
       }
-      if (used != seed.size() || seed.front() == '-') throw BadInput("--seed: '" + seed + "' is not a non-negative integer");
+      if (seed.empty() || used != seed.size() || seed.front() == '-') throw BadInput("--seed: '" + seed + "' is not a non-negative integer");
     }
-    if (!mode.empty()) e.mode = parse_mode(mode);
-    if (!backend.empty()) e.backend = parse_backend(backend);
+    if (given("--mode")) e.mode = parse_mode(mode);
+    if (given("--backend")) e.backend = parse_backend(backend);
     if (threads < 0) throw BadInput("--threads: '" + std::to_string(threads) + "' must be >= 0");
     e.threads = threads;
     if (!std::isfinite(alpha) || !(alpha > 0 && alpha < 1))
       throw BadInput("--alpha: '" + std::to_string(alpha) + "' must be in (0, 1)");
     scene.alpha = alpha;
     scene.plots = !no_plots;
-    if (!out.empty()) scene.out = out;
+    if (given("--out")) {
+      if (out.empty()) throw BadInput("--out: '' is not a directory name");
+      scene.out = out;
+    }
     if (preset_name != scene.name) scene.name = preset_name;
-    if (!asperities.empty() || !radius.empty() || !asperity_radius.empty() || !mode.empty())
+    if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode"))
       scene.name += "+custom";
     validate(scene);
     if (scene.plots && !plotting_available())

@@ -1,0 +1,129 @@
+// validate-geometry as a user meets it: every bad input is a clear error naming the value with
+// exit status 2 and no files left behind; a good run writes a report.json that honours the schema.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int status;
+  std::string out;  // stdout + stderr
+};
+
+CliRun run(const std::string& args) {
+  const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("asperity-cli-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+struct Bad {
+  std::string args;
+  std::string must_mention;
+};
+
+TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
+  const std::vector<Bad> cases = {
+      {"--asperities 0", "'0'"},          {"--asperities -5", "-5"},          {"--asperities abc", "abc"},
+      {"--asperities 1.5", "1.5"},        {"--asperities nan", "nan"},        {"--asperities inf", "inf"},
+      {"--asperities 1e40", "1e40"},      {"--asperities 5000000000", "5000000000"},
+      {"--radius 0", "'0'"},              {"--radius -1", "-1"},              {"--radius nan", "nan"},
+      {"--radius inf", "inf"},            {"--radius 3mm", "3mm"},            {"--radius ''", "''"},
+      {"--asperity-radius 0", "'0'"},     {"--asperity-radius 0.003", "smaller"},
+      {"--asperity-radius 1 --radius 0.5", "smaller"},                       {"--asperity-radius -1e-7", "-1e-7"},
+      {"--drops 0", "'0'"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
+      {"--preset fig99", "fig99"},        {"--backend octree --mode fixed", "octree"},
+      {"--mode frozen", "frozen"},        {"--alpha 0", "alpha"},             {"--alpha 1.5", "alpha"},
+      {"--alpha nan", "alpha"},           {"--threads -1", "-1"},             {"--seed -3", "-3"},
+      {"--seed x1", "x1"},                {"--mode fixed --spheres 3 --drops 1000", "multiple"},
+      {"--spheres 0 --mode fixed", "'0'"}, {"--frobnicate 3", "frobnicate"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = fresh_dir("bad");
+    const CliRun rr = run(c.args + " --out " + out.string());
+    EXPECT_EQ(rr.status, 2) << c.args << "\n" << rr.out;
+    EXPECT_NE(rr.out.find(c.must_mention), std::string::npos) << c.args << " did not name " << c.must_mention << ":\n" << rr.out;
+    EXPECT_FALSE(fs::exists(out) && !fs::is_empty(out)) << c.args << " left files in " << out;
+    fs::remove_all(out);
+  }
+}
+
+TEST(Cli, UnwritableOutputIsExitStatus2) {
+  const fs::path file = fresh_dir("file");
+  std::ofstream(file) << "not a directory";
+  CliRun r = run("--asperities 100 --drops 100 --out " + file.string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find(file.string()), std::string::npos) << r.out;
+  fs::remove(file);
+  r = run("--asperities 100 --drops 100 --out /proc/asperity-cannot-write-here");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("/proc/asperity-cannot-write-here"), std::string::npos) << r.out;
+}
+
+TEST(Cli, GoodRunWritesTheReportContract) {
+  const fs::path out = fresh_dir("good");
+  const CliRun r = run("--asperities 1000 --drops 20000 --no-plots --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("verdict"), std::string::npos);
+  std::ifstream f(out / "report.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j.at("mode"), "fresh");
+  EXPECT_EQ(j.at("samples"), 20000);
+  EXPECT_TRUE(j.at("core_contacts").is_number_unsigned());
+  EXPECT_EQ(j.at("parameters").at("asperities"), 1000);
+  EXPECT_EQ(j.at("parameters").at("radius_m"), 3e-3);
+  EXPECT_EQ(j.at("parameters").at("asperity_radius_m"), 6.5e-7);
+  for (const char* q : {"r_xy", "r_x", "r_y", "r_z"})
+    for (const char* k : {"mean", "mean_se", "std", "std_se", "quantiles"}) EXPECT_TRUE(j.at("quantities").at(q).contains(k)) << q << "." << k;
+  std::set<std::string> laws;
+  for (const auto& t : j.at("tests")) {
+    for (const char* k : {"quantity", "law", "D", "p", "verdict"}) EXPECT_TRUE(t.contains(k)) << k;
+    laws.insert(t.at("law").get<std::string>());
+  }
+  EXPECT_TRUE(laws.count("eq14") && laws.count("eq18") && laws.count("exact-sphere"));
+  for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
+  // No temporary files are left next to the report.
+  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().filename(), "report.json");
+  fs::remove_all(out);
+}
+
+TEST(Cli, ARejectedLawExitsWith1) {
+  // With N = 3 the flat-cap Poisson law of Eq. 14 is plainly wrong (the cap is the whole sphere):
+  // 20000 drops reject it (the exact law is accepted).
+  const fs::path out = fresh_dir("reject");
+  const CliRun r = run("--asperities 3 --drops 20000 --no-plots --out " + out.string());
+  EXPECT_EQ(r.status, 1) << r.out;
+  EXPECT_NE(r.out.find("reject"), std::string::npos);
+  fs::remove_all(out);
+}
+
+TEST(Cli, FiguresAreWrittenWhenAsked) {
+  if (std::system("gnuplot -e 'set terminal pngcairo' >/dev/null 2>&1") != 0) GTEST_SKIP() << "no gnuplot";
+  const fs::path out = fresh_dir("plots");
+  const CliRun r = run("--asperities 1000 --drops 5000 --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  for (const char* p : {"r_xy.png", "r_x.png", "r_y.png"}) EXPECT_GT(fs::file_size(out / p), 10000u) << p;
+  fs::remove_all(out);
+}
+
+}  // namespace
