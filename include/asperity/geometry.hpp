@@ -6,6 +6,7 @@
 // centre of asperity i is R*u_i. Storing unit vectors keeps the near-pole comparisons
 // scale-free: heights near the pole differ by ~R*theta^2/2, nanometres on a 3 mm sphere.
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross products of Vec3 everywhere
 
 #include <cstdint>
 #include <string>
