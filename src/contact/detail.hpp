@@ -46,5 +46,8 @@ std::unique_ptr<ContactQuery> make_nanoflann(std::span<const Vec3> centres);
 std::unique_ptr<ContactQuery> make_cgal(std::span<const Vec3> centres);
 std::unique_ptr<ContactQuery> make_fcl(std::span<const Vec3> centres);
 std::unique_ptr<ContactQuery> make_grid(std::span<const Vec3> centres);
+/// The grid with an explicit cells-per-face-edge `side` and face `margin` (0 = automatic), for
+/// tests and benchmarks of coarse and fine grids.
+std::unique_ptr<ContactQuery> make_grid_with(std::span<const Vec3> centres, int side, double margin);
 
 }  // namespace asperity::detail
