@@ -26,35 +26,33 @@ struct BadInput : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// Counts may be written as integers or in exact scientific notation ("1e5").
-std::uint64_t parse_count(const std::string& option, const std::string& text) {
+// Every number goes through here: the whole text must parse and be finite.
+double parse_real(const std::string& option, const std::string& text) {
   std::size_t used = 0;
   double v = 0;
   try {
     v = std::stod(text, &used);
   } catch (const std::exception&) {
-    throw BadInput(option + ": '" + text + "' is not a number");
+    used = 0;  // not a number, or out of the range of double
   }
-  if (used != text.size()) throw BadInput(option + ": '" + text + "' is not a number");
+  if (text.empty() || used != text.size()) throw BadInput(option + ": '" + text + "' is not a number");
   if (!std::isfinite(v)) throw BadInput(option + ": '" + text + "' must be finite");
+  return v;
+}
+
+double parse_positive(const std::string& option, const std::string& text, const char* unit = "metres") {
+  const double v = parse_real(option, text);
+  if (v <= 0) throw BadInput(option + ": '" + text + "' must be > 0 (" + unit + ")");
+  return v;
+}
+
+// Counts may be written as integers or in exact scientific notation ("1e5").
+std::uint64_t parse_count(const std::string& option, const std::string& text) {
+  const double v = parse_real(option, text);
   if (v < 1) throw BadInput(option + ": '" + text + "' must be >= 1");
   if (v != std::floor(v)) throw BadInput(option + ": '" + text + "' must be a whole number");
   if (v > 9.007199254740992e15) throw BadInput(option + ": '" + text + "' is too large");
   return static_cast<std::uint64_t>(v);
-}
-
-double parse_length(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    throw BadInput(option + ": '" + text + "' is not a number");
-  }
-  if (used != text.size()) throw BadInput(option + ": '" + text + "' is not a number");
-  if (!std::isfinite(v)) throw BadInput(option + ": '" + text + "' must be finite");
-  if (v <= 0) throw BadInput(option + ": '" + text + "' must be > 0 (metres)");
-  return v;
 }
 
 // Creates the directory if needed and proves it writable before any work starts.
@@ -110,7 +108,7 @@ int main(int argc, char** argv) {
   int threads = 0;
   double alpha = 0.01;
   bool no_plots = false, quiet = false;
-  app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed");
+  app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5");
   app.add_option("--asperities,-N", asperities, "number of asperities N (>= 1)");
   app.add_option("--radius", radius, "central sphere radius R [m]");
   app.add_option("--asperity-radius", asperity_radius, "asperity radius a [m], 0 < a < R");
@@ -122,6 +120,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", threads, "OpenMP threads (0 = all)");
   app.add_option("--alpha", alpha, "significance level of each test, in (0,1)");
   app.add_option("--out", out, "output directory for report.json and figures");
+  std::string speed, omega_x, omega_y;
+  app.add_option("--speed", speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
+  app.add_option("--omega-x", omega_x, "impact: spin Omega_x before [rad/s]");
+  app.add_option("--omega-y", omega_y, "impact: spin Omega_y before [rad/s]");
   app.add_flag("--no-plots", no_plots, "do not write PNG figures");
   app.add_flag("--quiet,-q", quiet, "print no progress");
   try {
@@ -140,8 +142,8 @@ int main(int argc, char** argv) {
     scene = preset(preset_name);
     auto& e = scene.ensemble;
     if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities);
-    if (given("--radius")) e.sphere.radius = parse_length("--radius", radius);
-    if (given("--asperity-radius")) e.sphere.asperity_radius = parse_length("--asperity-radius", asperity_radius);
+    if (given("--radius")) e.sphere.radius = parse_positive("--radius", radius);
+    if (given("--asperity-radius")) e.sphere.asperity_radius = parse_positive("--asperity-radius", asperity_radius);
     if (given("--drops")) e.drops = parse_count("--drops", drops);
     if (given("--spheres")) e.spheres = parse_count("--spheres", spheres);
     if (given("--seed")) {
@@ -154,6 +156,14 @@ int main(int argc, char** argv) {
       if (seed.empty() || used != seed.size() || seed.front() == '-') throw BadInput("--seed: '" + seed + "' is not a non-negative integer");
     }
     if (given("--mode")) e.mode = parse_mode(mode);
+    if (given("--speed")) {
+      e.impact.enabled = true;
+      e.impact.speed = parse_positive("--speed", speed, "m/s");
+    }
+    if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", omega_x);
+    if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", omega_y);
+    if ((given("--omega-x") || given("--omega-y")) && !e.impact.enabled)
+      throw BadInput("--omega-x/--omega-y need an impact: give --speed or a preset with impacts (fig4, fig5)");
     if (given("--backend")) e.backend = parse_backend(backend);
     if (threads < 0) throw BadInput("--threads: '" + std::to_string(threads) + "' must be >= 0");
     e.threads = threads;
@@ -166,7 +176,8 @@ int main(int argc, char** argv) {
       scene.out = out;
     }
     if (preset_name != scene.name) scene.name = preset_name;
-    if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode"))
+    if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
+        given("--speed") || given("--omega-x") || given("--omega-y"))
       scene.name += "+custom";
     validate(scene);
     if (scene.plots && !plotting_available())
