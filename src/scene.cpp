@@ -5,7 +5,7 @@
 
 namespace asperity {
 
-std::vector<std::string> preset_names() { return {"fig3", "fig3-fixed"}; }
+std::vector<std::string> preset_names() { return {"fig3", "fig3-fixed", "fig4", "fig5"}; }
 
 Scene preset(std::string_view name) {
   Scene s;
@@ -23,6 +23,23 @@ Scene preset(std::string_view name) {
     s.ensemble.mode = Mode::fixed;
     s.ensemble.spheres = 100;
     s.ensemble.backend = Backend::grid;
+    return s;
+  }
+  if (name == "fig4") {
+    // Fig. 4: eps from explicit geometry + the full impulse; V.n = 1.3 m/s, Omega_x = 0.2 rad/s.
+    s.name = "fig4";
+    s.ensemble.impact.enabled = true;
+    s.ensemble.impact.speed = 1.3;
+    s.ensemble.impact.omega = Vec3(0.2, 0.0, 0.0);
+    return s;
+  }
+  if (name == "fig5") {
+    // Fig. 5: Omega'_x with Omega = 0, V.n = 1 m/s, a = R x 1e-4.
+    s.name = "fig5";
+    s.ensemble.sphere.asperity_radius = 3e-3 * 1e-4;
+    s.ensemble.impact.enabled = true;
+    s.ensemble.impact.speed = 1.0;
+    s.ensemble.impact.omega = Vec3(0.0, 0.0, 0.0);
     return s;
   }
   std::string known;

@@ -22,6 +22,17 @@ std::string_view to_string(Mode m);
 /// "fresh" or "fixed"; throws std::invalid_argument naming the value otherwise.
 Mode parse_mode(std::string_view s);
 
+/// A single impact per drop (paper Sec. IV): the body falls onto a horizontal plate (n = +z) with
+/// V = (0, 0, -speed) and spin omega; the impulse is solved with the full rigid-body law.
+struct ImpactExperiment {
+  bool enabled = false;
+  double speed = 1.3;            ///< u = -V.n > 0 [m/s]
+  Vec3 omega{0.2, 0.0, 0.0};     ///< Omega before [rad/s]
+  double density = 7850;         ///< [kg/m^3]; mass M = 4/3 pi R^3 density (eps does not depend on it)
+  double beta = 0.0467;          ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
+  double eps_t = 1.0;            ///< tangential restitution (paper: 1)
+};
+
 struct EnsembleConfig {
   SphereParams sphere;
   Mode mode = Mode::fresh;
@@ -30,6 +41,7 @@ struct EnsembleConfig {
   std::uint64_t seed = 1;
   Backend backend = Backend::grid;  ///< fixed mode only
   int threads = 0;                  ///< 0 = OpenMP default
+  ImpactExperiment impact;          ///< off: contact statistics only (nothing else is computed)
 };
 
 /// Throws std::invalid_argument naming the offending field.
@@ -43,7 +55,14 @@ struct ContactSamples {
   std::vector<double> gap;          ///< runner-up height gap [m] (+inf if N == 1)
   std::vector<std::uint8_t> core;   ///< 1 if the central sphere touches first
   std::uint64_t core_contacts = 0;
-  double seconds_generate = 0, seconds_index = 0, seconds_query = 0;
+  // Impact results (empty unless the experiment is enabled). The impulse uses the physical contact:
+  // the lowest asperity's r, or the central sphere's pole (0, 0, -R) in a core contact.
+  std::vector<double> eps;            ///< macroscopic restitution coefficient, Eq. 1
+  std::vector<double> omega_x_after;  ///< Omega'_x [rad/s]
+  std::vector<double> eps_n;          ///< microscopic eps_n at the contact's normal speed
+  std::uint64_t no_impacts = 0;       ///< drops whose contact point does not approach the plate (v_n >= 0):
+                                      ///< counted here, absent from eps/omega_x_after/eps_n
+  double seconds_generate = 0, seconds_index = 0, seconds_query = 0, seconds_impact = 0;
   std::size_t index_bytes = 0;      ///< memory of one spatial index (fixed mode)
 };
 

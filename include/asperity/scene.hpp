@@ -22,6 +22,9 @@ struct Scene {
 std::vector<std::string> preset_names();
 /// The scene of a preset; throws std::invalid_argument naming the value for an unknown name.
 /// fig3: the paper's Fig. 3 -- N = 1e5, R = 3 mm, a = 6.5e-7 m, fresh spheres, 1e6 drops.
+/// fig3-fixed: the same from 100 explicit spheres x 1e4 rotations (grid backend).
+/// fig4: Fig. 3's sphere dropped at V.n = 1.3 m/s with Omega_x = 0.2 rad/s: eps and Omega'_x.
+/// fig5: Omega = 0, V.n = 1 m/s, a = R x 1e-4: Omega'_x.
 Scene preset(std::string_view name);
 
 /// Throws std::invalid_argument naming the offending field and value.
