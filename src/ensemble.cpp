@@ -133,6 +133,7 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
       continue;
     }
     s.eps.push_back(eps[k]), s.omega_x_after.push_back(wx[k]), s.eps_n.push_back(en[k]);
+    s.eps_core.push_back(s.core[k]);
   }
   s.seconds_impact = since(t0);
 }

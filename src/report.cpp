@@ -14,7 +14,9 @@
 #include <unistd.h>
 
 #include "asperity/plot.hpp"
+#include "asperity/random.hpp"
 #include "asperity/theory.hpp"
+#include "asperity/theory_impact.hpp"
 
 namespace asperity {
 
@@ -30,25 +32,88 @@ std::vector<double> sorted(std::vector<double> v) {
   return v;
 }
 
+// KS of x against a law with an atom of mass m at `atom`, taken by the samples flagged in `at_atom`:
+// u_i = F(x_i) elsewhere, u_i = F(atom) - m + V_i m there (V_i uniform from a counter-based
+// stream), and the u_i are tested against the uniform law. Without atom samples this is the plain
+// KS test. Parallel over samples; the result does not depend on the thread count.
+KsResult ks_mixed(const std::vector<double>& x, const std::vector<std::uint8_t>& at_atom, const Law& law, double atom,
+                  double mass, std::uint64_t seed) {
+  std::vector<double> u(x.size());
+  const double below = law.cdf(atom) - mass;
+  const std::int64_t n = static_cast<std::int64_t>(x.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (!at_atom.empty() && at_atom[k]) {
+      Stream st(seed, Purpose::analysis, k);
+      u[k] = below + st.uniform0() * mass;
+    } else {
+      u[k] = law.cdf(x[k]);
+    }
+  }
+  std::sort(u.begin(), u.end());
+  return ks_one_sample(u, [](double t) { return std::clamp(t, 0.0, 1.0); });
+}
+
 struct LawSet {
   std::string quantity;
   std::vector<Law> laws;
+  std::vector<bool> decisive;  // printed laws with known errors are reported, not decisive
+  // Corrected impact laws include core contacts as an atom of mass p_core at `atom`; their KS
+  // test uses the randomised probability integral transform there (exact for mixed laws).
+  std::vector<bool> has_atom = {};
+  double atom = 0, atom_mass = 0;
 };
 
-std::vector<LawSet> laws_for(const SphereParams& p) {
+ImpactScene impact_scene(const EnsembleConfig& e) {
+  ImpactScene x;
+  x.asperities = e.sphere.asperities;
+  x.radius = e.sphere.radius;
+  x.asperity_radius = e.sphere.asperity_radius;
+  x.speed = e.impact.speed;
+  x.omega_x = e.impact.omega.x();
+  x.omega_y = e.impact.omega.y();
+  x.beta = e.impact.beta;
+  return x;
+}
+
+std::vector<LawSet> laws_for(const EnsembleConfig& e) {
+  const auto& p = e.sphere;
   const double R = p.radius;
   const auto n = p.asperities;
   const Law rx = exact_sphere_rx(n, R);  // tabulated once, shared by r_x and r_y
-  return {{"r_xy", {eq14_rxy(n, R), exact_sphere_rxy(n, R)}},
-          {"r_x", {eq18_rx(n, R), rx}},
-          {"r_y", {eq18_rx(n, R), rx}}};
+  std::vector<LawSet> sets{{"r_xy", {eq14_rxy(n, R), exact_sphere_rxy(n, R)}, {true, true}, {false, false}},
+                           {"r_x", {eq18_rx(n, R), rx}, {true, true}, {false, false}},
+                           {"r_y", {eq18_rx(n, R), rx}, {true, true}, {false, false}}};
+  // The Sec. IV laws assume eps_t = 1 and a horizontal spin.
+  if (e.impact.enabled && e.impact.eps_t == 1.0 && e.impact.omega.z() == 0.0) {
+    ImpactScene x = impact_scene(e);
+    ImpactScene physical = x;
+    physical.core_contacts = true;  // explicit geometry lets the bare sphere touch: so must the law
+    const auto par = impact_law_parameters(physical);
+    sets.push_back({"eps", {eq28_printed(x), eq28_paper_route(x), eq28_corrected(physical)}, {false, false, true},
+                    {false, false, true}, par.eps_n, par.p_core});
+    sets.push_back({"omega_x_after", {eq33_printed(x), eq33_corrected(physical)}, {false, true}, {false, true},
+                    x.omega_x, par.p_core});
+  }
+  return sets;
 }
 
 const std::vector<double>& column(const ContactSamples& s, const std::string& q) {
   if (q == "r_xy") return s.r_xy;
   if (q == "r_x") return s.r_x;
   if (q == "r_y") return s.r_y;
+  if (q == "eps") return s.eps;
+  if (q == "omega_x_after") return s.omega_x_after;
   return s.r_z;
+}
+
+// Display scale and unit of a quantity in the table (JSON is always SI).
+double display_scale(const std::string& q) { return q.rfind("r_", 0) == 0 ? 1e6 : 1.0; }
+std::string si_unit(const std::string& q) {
+  if (q == "eps") return "1";
+  if (q == "omega_x_after") return "rad/s";
+  return "m";
 }
 
 std::string fmt(double v, int prec = 4) {
@@ -99,23 +164,51 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
         "drops are iid. Only the asperities that can touch are generated (exact order statistics).";
   }
 
-  for (const std::string q : {"r_xy", "r_x", "r_y", "r_z"}) {
+  std::vector<std::string> names{"r_xy", "r_x", "r_y", "r_z"};
+  // Impact quantities are batched by sphere only when every drop impacted (no drop missing).
+  const bool impact = scene.ensemble.impact.enabled && !s.eps.empty();
+  if (impact) names.insert(names.end(), {"eps", "omega_x_after"});
+  for (const auto& q : names) {
     const auto& x = column(s, q);
-    r.quantities.push_back({q, fixed ? summarize_batches(x, K, kProbs) : summarize_iid(x, kProbs)});
+    const bool batched = fixed && x.size() == n;
+    r.quantities.push_back({q, batched ? summarize_batches(x, K, kProbs) : summarize_iid(x, kProbs)});
   }
+  if (impact) {
+    std::vector<double> deficit(s.eps.size());
+    for (std::size_t i = 0; i < deficit.size(); ++i) deficit[i] = s.eps_n[i] - s.eps[i];
+    const bool batched = fixed && deficit.size() == n;
+    const Summary d = batched ? summarize_batches(deficit, K, kProbs) : summarize_iid(deficit, kProbs);
+    r.eps_deficit = d.mean;
+    double en = 0;
+    for (double e : s.eps_n) en += e;
+    r.eps_n_mean = en / double(s.eps_n.size());
+  }
+  r.no_impacts = s.no_impacts;
 
-  for (const auto& set : laws_for(sp)) {
+  for (const auto& set : laws_for(scene.ensemble)) {
     const auto& x = column(s, set.quantity);
+    if (x.empty()) continue;
+    const bool all_drops = x.size() == n;
     const auto all = sorted(x);
     std::vector<double> first;
-    if (fixed) {
-      for (std::size_t k = 0; k < K; ++k) first.push_back(x[k * M]);
-      std::sort(first.begin(), first.end());
+    std::vector<std::uint8_t> first_core;
+    if (fixed && all_drops) {
+      for (std::size_t k = 0; k < K; ++k) {
+        first.push_back(x[k * M]);
+        if (!s.eps_core.empty()) first_core.push_back(s.eps_core[k * M]);
+      }
     }
-    for (const auto& law : set.laws) {
+    for (std::size_t li = 0; li < set.laws.size(); ++li) {
+      const Law& law = set.laws[li];
+      const bool decisive_law = set.decisive[li];
       const double mean = law.mean;
-      TestReport t{set.quantity, law.name, fixed ? "pooled" : "all", "KS", 0, 1, n, mean, !fixed, !fixed, "", ""};
-      const auto ks = ks_one_sample(all, law.cdf);
+      TestReport t{set.quantity, law.name, fixed ? "pooled" : "all", "KS", 0, 1, x.size(), mean, !fixed,
+                   !fixed && decisive_law, "", ""};
+      if (!decisive_law) t.note = "as printed in the paper; reported for comparison, not decisive";
+      const bool atom = li < set.has_atom.size() && set.has_atom[li];
+      const auto ks = atom ? ks_mixed(x, s.eps_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
+                           : ks_one_sample(all, law.cdf);
+      if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
       t.D = ks.D, t.p = ks.p;
       if (!fixed) {
         t.verdict = ks.p < scene.alpha ? "reject" : "accept";
@@ -132,9 +225,11 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
         }
         if (t.note.empty()) t.note = "p-value assumes iid drops; rotations of one sphere are correlated";
         r.tests.push_back(t);
+        if (first.empty()) continue;
         // The decisive test: one rotation per sphere gives K iid draws of the ensemble law.
-        const auto ks1 = ks_one_sample(first, law.cdf);
-        TestReport t1{set.quantity, law.name, "one-per-sphere", "KS", ks1.D, ks1.p, K, mean, true, true,
+        const auto ks1 = atom ? ks_mixed(first, first_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
+                              : ks_one_sample(sorted(first), law.cdf);
+        TestReport t1{set.quantity, law.name, "one-per-sphere", "KS", ks1.D, ks1.p, K, mean, true, decisive_law,
                       ks1.p < scene.alpha ? "reject" : "accept", "first rotation of each sphere: iid"};
         r.tests.push_back(t1);
         continue;
@@ -158,6 +253,7 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
     r.tests.push_back(t);
   }
   r.timings_s = {{"generate", s.seconds_generate}, {"index", s.seconds_index}, {"query", s.seconds_query}};
+  if (scene.ensemble.impact.enabled) r.timings_s.emplace_back("impact", s.seconds_impact);
   return r;
 }
 
@@ -167,31 +263,38 @@ std::string format_table(const GeometryReport& r) {
   os << "validate-geometry: scene " << r.scene.name << ", " << to_string(r.scene.ensemble.mode) << " ensemble, N = "
      << sp.asperities << ", R = " << sp.radius << " m, a = " << sp.asperity_radius << " m, " << r.samples
      << " drops, seed " << r.scene.ensemble.seed << "\n";
-  os << "lengths in micrometres; KS = one-sample Kolmogorov-Smirnov, alpha = " << r.scene.alpha << " per test\n\n";
+  os << "lengths in micrometres, omega in rad/s; KS = one-sample Kolmogorov-Smirnov, alpha = " << r.scene.alpha << " per test\n\n";
   os << std::left << std::setw(14) << "quantity" << std::setw(24) << "measured mean +- se" << std::setw(14) << "law"
      << std::setw(12) << "law mean" << std::setw(16) << "scope" << std::setw(10) << "KS D" << std::setw(11) << "p"
      << "verdict\n";
-  os << std::string(108, '-') << "\n";
+  os << std::string(112, '-') << "\n";
   for (const auto& t : r.tests) {
     std::string measured = "-";
-    double scale = 1e6;
+    const double scale = display_scale(t.quantity);
     if (t.quantity == "core_contacts") {
       measured = std::to_string(r.core_contacts);
-      scale = 1;
     } else {
+      const int digits = t.quantity == "eps" ? 8 : 5;
       for (const auto& q : r.quantities)
         if (q.name == t.quantity)
-          measured = fmt(q.summary.mean.value * 1e6, 5) + " +- " + fmt(q.summary.mean.se * 1e6, 2);
+          measured = fmt(q.summary.mean.value * scale, digits) + " +- " + fmt(q.summary.mean.se * scale, 2);
     }
     std::string verdict = t.verdict;
     if (!t.decisive) verdict += " (info)";
-    os << std::left << std::setw(14) << t.quantity << std::setw(24) << measured << std::setw(14) << t.law
-       << std::setw(12) << fmt(t.predicted_mean * scale, 5) << std::setw(16) << t.scope << std::setw(10) << fmt(t.D, 3)
+    os << std::left << std::setw(14) << t.quantity << std::setw(24) << measured << std::setw(18) << t.law
+       << std::setw(12) << fmt(t.predicted_mean * scale, t.quantity == "eps" ? 8 : 5) << std::setw(16) << t.scope << std::setw(10) << fmt(t.D, 3)
        << std::setw(11) << fmt(t.p, 3) << verdict << "\n";
   }
   os << "\ncore contacts: " << r.core_contacts << " of " << r.samples << " drops (expected "
      << fmt(r.core_probability * double(r.samples), 4) << "; paper's estimate per drop " << fmt(r.core_probability_paper, 3)
      << ")\n";
+  if (r.scene.ensemble.impact.enabled) {
+    const auto& x = r.scene.ensemble.impact;
+    os << "impact: u = " << x.speed << " m/s, Omega = (" << x.omega.x() << ", " << x.omega.y() << ", " << x.omega.z()
+       << ") rad/s, eps_t = " << x.eps_t << ", Pade [1/4] beta = " << x.beta << "; mean eps_n = " << fmt(r.eps_n_mean, 8)
+       << ", deficit eps_n - <eps> = " << fmt(r.eps_deficit.value, 4) << " +- " << fmt(r.eps_deficit.se, 2)
+       << "; drops without impact: " << r.no_impacts << "\n";
+  }
   os << "runner-up gap: min " << fmt(r.gap_min * 1e9, 4) << " nm, median " << fmt(r.gap_median * 1e9, 4) << " nm\n";
   os << r.ensemble_note << "\n";
   os << "verdict: " << (r.rejected() ? "a law was REJECTED" : "no law rejected") << "\n";
@@ -218,6 +321,19 @@ std::string to_json(const GeometryReport& r) {
                      {"seed", e.seed},
                      {"backend", e.mode == Mode::fixed ? std::string(to_string(e.backend)) : std::string("none")},
                      {"alpha", r.scene.alpha}};
+  if (e.impact.enabled) {
+    const auto& x = e.impact;
+    j["impact"] = {{"speed_m_s", x.speed},
+                   {"omega_rad_s", {x.omega.x(), x.omega.y(), x.omega.z()}},
+                   {"density_kg_m3", x.density},
+                   {"beta", x.beta},
+                   {"eps_t", x.eps_t},
+                   {"restitution_model", "viscoelastic-pade14"},
+                   {"solver", "closed form (Sherman-Morrison), tested against the general 3x3 solve"}};
+    j["no_impacts"] = r.no_impacts;
+    j["eps_n_mean"] = r.eps_n_mean;
+    j["eps_deficit"] = {{"value", r.eps_deficit.value}, {"se", r.eps_deficit.se}};
+  }
   j["ensemble_note"] = r.ensemble_note;
   if (e.mode == Mode::fixed) j["quenched_deviation_scale"] = r.quenched_scale;
   j["runner_up_gap_m"] = {{"min", r.gap_min}, {"median", r.gap_median}};
@@ -227,7 +343,7 @@ std::string to_json(const GeometryReport& r) {
     json qs = json::array();
     for (std::size_t i = 0; i < s.probs.size(); ++i)
       qs.push_back({{"p", s.probs[i]}, {"value", s.quantiles[i].value}, {"se", s.quantiles[i].se}});
-    q[qr.name] = {{"unit", "m"},     {"n", s.n},       {"mean", s.mean.value}, {"mean_se", s.mean.se},
+    q[qr.name] = {{"unit", si_unit(qr.name)},     {"n", s.n},       {"mean", s.mean.value}, {"mean_se", s.mean.se},
                   {"std", s.std.value}, {"std_se", s.std.se}, {"quantiles", qs},   {"se_batches", s.batches}};
   }
   j["quantities"] = q;
@@ -285,25 +401,45 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
   std::ostringstream sub;
   sub << "N = " << sp.asperities << ", {/Symbol r} = " << sp.asperity_radius << " m, " << to_string(scene.ensemble.mode)
       << ", n = " << s.r_xy.size();
-  for (const auto& set : laws_for(sp)) {
-    const bool radial = set.quantity == "r_xy";
-    const double hi = std::min(sp.radius, (radial ? 4.5 : 4.0) * sigma);
-    const double lo = radial ? 0.0 : -hi;
+  for (const auto& set : laws_for(scene.ensemble)) {
+    const auto& x = column(s, set.quantity);
+    if (x.empty()) continue;
     HistogramFigure fig;
-    const std::string sym = radial ? "r_{xy}" : (set.quantity == "r_x" ? "r_x" : "r_y");
-    fig.title = sym + " of the contact vector: " + sub.str();
-    fig.xlabel = sym + " [{/Symbol m}m]";
-    fig.x_scale = 1e6;
-    fig.y_scale = 1e-6;
-    fig.ylabel = "probability density [1/{/Symbol m}m]";
-    fig.histogram = make_histogram(column(s, set.quantity), lo, hi, 60);
+    double lo, hi;
+    if (set.quantity.rfind("r_", 0) == 0) {
+      const bool radial = set.quantity == "r_xy";
+      hi = std::min(sp.radius, (radial ? 4.5 : 4.0) * sigma);
+      lo = radial ? 0.0 : -hi;
+      const std::string sym = radial ? "r_{xy}" : (set.quantity == "r_x" ? "r_x" : "r_y");
+      fig.title = sym + " of the contact vector: " + sub.str();
+      fig.xlabel = sym + " [{/Symbol m}m]";
+      fig.x_scale = 1e6;
+      fig.y_scale = 1e-6;
+      fig.ylabel = "probability density [1/{/Symbol m}m]";
+    } else {
+      // Range from the data: the bulk plus the tails the log panel shows.
+      auto v = sorted(x);
+      lo = quantile_sorted(v, 1e-4), hi = quantile_sorted(v, 1.0 - 1e-5);
+      const double pad = 0.05 * (hi - lo);
+      lo -= pad, hi += pad;
+      if (!(hi > lo)) lo -= 1e-12, hi += 1e-12;
+      const bool eps = set.quantity == "eps";
+      fig.title = (eps ? std::string("{/Symbol e}") : std::string("{/Symbol W}'_x")) + ": " + sub.str();
+      fig.xlabel = eps ? "{/Symbol e}" : "{/Symbol W}'_x [rad/s]";
+      fig.ylabel = eps ? "probability density" : "probability density [s/rad]";
+    }
+    fig.histogram = make_histogram(x, lo, hi, 60);
     for (const auto& law : set.laws) {
       Curve c;
-      c.label = law.name == "eq14" ? "Eq. (14), Rayleigh" : law.name == "eq18" ? "Eq. (18), Gaussian" : "exact finite-N law on the sphere";
+      c.label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
+                : law.name == "eq18" ? "Eq. (18), Gaussian"
+                : law.name == "exact-sphere" ? "exact finite-N law on the sphere"
+                                             : law.name;
       for (int i = 0; i <= 300; ++i) {
         const double t = lo + (hi - lo) * i / 300.0;
+        const double y = law.pdf(t);
         c.x.push_back(t);
-        c.y.push_back(law.pdf(t));
+        c.y.push_back(std::isfinite(y) ? y : 0.0);
       }
       fig.curves.push_back(std::move(c));
     }

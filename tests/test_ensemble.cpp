@@ -168,3 +168,61 @@ TEST(Core, CentralSphereContactsAreCountedAtTheExactRate) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Fig4, CorrectedLawsConfirmedPrintedLawsRejected) {
+  // Fig. 4's scene (N = 1e5, u = 1.3 m/s, Omega_x = 0.2 rad/s) at its default 10^6 drops: explicit
+  // geometry + the full impulse. The corrected eps law (Eq. 28) and Omega'_x law (Eq. 33) must be
+  // accepted at alpha = 0.01; the printed Eq. 33 (6x too wide) must be rejected overwhelmingly.
+  Scene s = preset("fig4");
+  const auto samples = run_contact_ensemble(s.ensemble);
+  ASSERT_EQ(samples.eps.size(), 1000000u);
+  EXPECT_EQ(samples.no_impacts, 0u);
+  const auto r = analyse(s, samples);
+  EXPECT_EQ(find(r, "eps", "eq28-corrected", "all").verdict, "accept") << find(r, "eps", "eq28-corrected", "all").p;
+  EXPECT_EQ(find(r, "omega_x_after", "eq33-corrected", "all").verdict, "accept");
+  EXPECT_LT(find(r, "omega_x_after", "eq33-printed", "all").p, 1e-10);
+  EXPECT_FALSE(find(r, "omega_x_after", "eq33-printed", "all").decisive);
+  EXPECT_FALSE(r.rejected());
+  // Every eps lies below eps_n(u) except for the Omega-induced tilt, and the deficit is tiny.
+  EXPECT_GT(r.eps_deficit.value, 0.0);
+  EXPECT_LT(r.eps_deficit.value, 1e-3);
+}
+
+TEST(Fig5, SpinAfterImpactFollowsTheCorrectedEq33) {
+  Scene s = preset("fig5");
+  s.ensemble.drops = 200000;
+  const auto r = analyse(s, run_contact_ensemble(s.ensemble));
+  EXPECT_EQ(find(r, "omega_x_after", "eq33-corrected", "all").verdict, "accept");
+  EXPECT_EQ(find(r, "eps", "eq28-corrected", "all").verdict, "accept");
+  EXPECT_EQ(find(r, "omega_x_after", "eq33-printed", "all").verdict, "reject");
+  EXPECT_FALSE(r.rejected());
+}
+
+TEST(Impacts, BitIdenticalForOneAndTwoThreadsAndCoreContactsUseThePole) {
+  EnsembleConfig c;
+  c.sphere = {1000, 3e-3, 3e-3 * 2.4e-3};  // ~30% core contacts
+  c.drops = 20000;
+  c.impact.enabled = true;
+  c.impact.speed = 1.0;
+  c.impact.omega = Vec3(0, 0, 0);
+  c.threads = 1;
+  const auto a = run_contact_ensemble(c);
+  c.threads = 2;
+  const auto b = run_contact_ensemble(c);
+  EXPECT_EQ(a.eps, b.eps);
+  EXPECT_EQ(a.omega_x_after, b.omega_x_after);
+  // A core contact is central (r parallel to n): eps = eps_n exactly, no spin.
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < a.core.size(); ++i)
+    if (a.core[i]) {
+      EXPECT_NEAR(a.eps[i], a.eps_n[i], 1e-15);
+      EXPECT_EQ(a.omega_x_after[i], 0.0);
+      ++k;
+    }
+  EXPECT_GT(k, 1000u);
+  omp_set_num_threads(omp_get_num_procs());
+}
+
+}  // namespace

@@ -60,6 +60,7 @@ struct ContactSamples {
   std::vector<double> eps;            ///< macroscopic restitution coefficient, Eq. 1
   std::vector<double> omega_x_after;  ///< Omega'_x [rad/s]
   std::vector<double> eps_n;          ///< microscopic eps_n at the contact's normal speed
+  std::vector<std::uint8_t> eps_core; ///< 1 where that impact was a core contact (aligned with eps)
   std::uint64_t no_impacts = 0;       ///< drops whose contact point does not approach the plate (v_n >= 0):
                                       ///< counted here, absent from eps/omega_x_after/eps_n
   double seconds_generate = 0, seconds_index = 0, seconds_query = 0, seconds_impact = 0;

@@ -14,6 +14,7 @@ enum class Purpose : std::uint32_t {
   sphere = 1,       ///< asperity positions of one explicit sphere
   orientation = 2,  ///< a random rotation of a drop
   fresh = 3,        ///< the cap of a fresh random sphere
+  analysis = 4,     ///< randomisation inside statistical tests (e.g. the PIT at an atom)
   test = 99,        ///< reserved for tests
 };
 

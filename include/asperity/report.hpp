@@ -16,7 +16,7 @@ namespace asperity {
 inline constexpr int kReportSchemaVersion = 1;
 
 struct QuantityReport {
-  std::string name;  ///< "r_xy", "r_x", "r_y", "r_z"
+  std::string name;  ///< "r_xy", "r_x", "r_y", "r_z" [m]; "eps" [1], "omega_x_after" [rad/s]
   Summary summary;   ///< SI units (metres)
 };
 
@@ -49,6 +49,10 @@ struct GeometryReport {
   std::vector<std::pair<std::string, double>> timings_s;
   std::vector<std::string> plots;     ///< file names written in the output directory
   std::size_t index_bytes = 0;
+  // Impact experiments only:
+  std::uint64_t no_impacts = 0;       ///< contacts that did not approach the plate
+  double eps_n_mean = 0;              ///< mean microscopic eps_n
+  Estimate eps_deficit;               ///< eps_n - <eps> with its standard error
 
   /// A decisive test rejected its law.
   bool rejected() const;
