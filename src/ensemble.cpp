@@ -25,7 +25,8 @@ Mode parse_mode(std::string_view s) {
 
 void validate(const EnsembleConfig& c) {
   validate(c.sphere);
-  if (c.drops < 1) throw std::invalid_argument("drops must be >= 1, got 0");
+  if (c.drops < 2)
+    throw std::invalid_argument("drops must be >= 2 (a standard error needs two samples), got " + std::to_string(c.drops));
   if (c.drops > (std::uint64_t{1} << 31))
     throw std::invalid_argument("drops must be <= 2^31, got " + std::to_string(c.drops));
   if (c.mode == Mode::fixed) {

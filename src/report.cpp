@@ -166,17 +166,18 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
 
   std::vector<std::string> names{"r_xy", "r_x", "r_y", "r_z"};
   // Impact quantities are batched by sphere only when every drop impacted (no drop missing).
-  const bool impact = scene.ensemble.impact.enabled && !s.eps.empty();
+  const bool impact = scene.ensemble.impact.enabled && s.eps.size() >= 2;
   if (impact) names.insert(names.end(), {"eps", "omega_x_after"});
   for (const auto& q : names) {
     const auto& x = column(s, q);
-    const bool batched = fixed && x.size() == n;
+    // One rotation per sphere (M = 1) is iid: batch means need M >= 2.
+    const bool batched = fixed && x.size() == n && M >= 2;
     r.quantities.push_back({q, batched ? summarize_batches(x, K, kProbs) : summarize_iid(x, kProbs)});
   }
   if (impact) {
     std::vector<double> deficit(s.eps.size());
     for (std::size_t i = 0; i < deficit.size(); ++i) deficit[i] = s.eps_n[i] - s.eps[i];
-    const bool batched = fixed && deficit.size() == n;
+    const bool batched = fixed && deficit.size() == n && M >= 2;
     const Summary d = batched ? summarize_batches(deficit, K, kProbs) : summarize_iid(deficit, kProbs);
     r.eps_deficit = d.mean;
     double en = 0;
