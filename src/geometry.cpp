@@ -5,18 +5,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "format.hpp"
+
 #include "asperity/random.hpp"
 
 namespace asperity {
 
-namespace {
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
-}  // namespace
+using detail::num;
 
 void validate(const SphereParams& p) {
   if (p.asperities < 1) throw std::invalid_argument("asperities must be >= 1, got 0");

@@ -4,16 +4,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "format.hpp"
+
 namespace asperity {
 
-namespace {
+using detail::num;
 
-std::string num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
+namespace {
 
 void check_speed(double v) {
   if (!(v >= 0) || !std::isfinite(v)) throw std::invalid_argument("restitution: contact speed must be finite and >= 0 m/s, got " + num(v));

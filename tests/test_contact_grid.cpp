@@ -11,17 +11,11 @@
 #include <vector>
 
 #include "asperity/contact.hpp"
+#include "print_nearest.hpp"
 #include "asperity/geometry.hpp"
 #include "asperity/random.hpp"
 #include "contact/detail.hpp"
 
-namespace asperity {
-void PrintTo(const Nearest& n, std::ostream* os) {
-  os->precision(17);
-  *os << "{index " << n.index << ", key " << n.key << ", runner_up " << n.runner_up << ", runner_up_key "
-      << n.runner_up_key << "}";
-}
-}  // namespace asperity
 
 namespace {
 

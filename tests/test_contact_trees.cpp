@@ -9,17 +9,10 @@
 #include <vector>
 
 #include "asperity/contact.hpp"
+#include "print_nearest.hpp"
 #include "asperity/geometry.hpp"
 #include "asperity/random.hpp"
 
-namespace asperity {
-// Readable failure messages for EXPECT_EQ on Nearest.
-void PrintTo(const Nearest& n, std::ostream* os) {
-  os->precision(17);
-  *os << "{index " << n.index << ", key " << n.key << ", runner_up " << n.runner_up << ", runner_up_key "
-      << n.runner_up_key << "}";
-}
-}  // namespace asperity
 
 namespace {
 
