@@ -152,10 +152,10 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
     os << "fixed ensemble: " << K << " explicit sphere(s) x " << M
        << " rotations. Rotations of one sphere sample that sphere's own (quenched) law, which differs from the "
           "ensemble law by a KS distance of order "
-       << fmt(r.quenched_scale, 3) << " per sphere (~0.42/sqrt(N)); pooled over K spheres, ~"
+       << fmt(r.quenched_scale, 3) << " per sphere (~0.23/sqrt(N)); pooled over K spheres, ~"
        << fmt(r.quenched_scale / std::sqrt(double(K)), 3) << ". Statistical KS noise of the pooled sample is ~"
        << fmt(kKsMean / std::sqrt(double(n)), 3)
-       << ", so the pooled tests are expected to reject once rotations per sphere exceed ~4N. Standard errors come "
+       << ", so the pooled tests are expected to reject once rotations per sphere exceed ~14N. Standard errors come "
           "from the spread between spheres (batch means); decisive tests use one rotation per sphere (iid).";
     r.ensemble_note = os.str();
   } else {

@@ -163,7 +163,12 @@ double quenched_cdf_sd(std::uint64_t n, double mu) {
   };
   auto g = [&](double u) { return u * std::expm1(mu * lens(u) / pi); };
   const double G = 2.0 * boost::math::quadrature::gauss_kronrod<double, 31>::integrate(g, 0.0, 2.0, 15, 1e-10);
-  return std::sqrt(mu * std::exp(-2.0 * mu) * G / static_cast<double>(n));
+  // Law of total variance: a Poisson process is a mixture over the count; one sphere has exactly
+  // N centres, so the part due to a random count, (d E[F]/dN)^2 Var(N) = (mu e^{-mu})^2 / N, is
+  // removed. (G >= mu, so the difference is never negative.)
+  const double e = std::exp(-mu);
+  const double var = (mu * e * e * G - mu * mu * e * e) / static_cast<double>(n);
+  return std::sqrt(std::max(0.0, var));
 }
 
 double quenched_deviation_scale(std::uint64_t n) {

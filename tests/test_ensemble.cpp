@@ -112,7 +112,7 @@ TEST(Fig3, DefaultSceneAcceptsTheLawsAndRejectsAWrongOne) {
 
 TEST(Fixed, ManyRotationsOfOneSmallSphereAreReportedAsQuenched) {
   // M = 2e5 rotations of ONE sphere with N = 200: its own law differs from the ensemble law by
-  // D ~ 0.42/sqrt(200) ~ 0.03 while the statistical resolution is ~0.002. The pooled KS must see
+  // D ~ 0.23/sqrt(200) ~ 0.017 while the statistical resolution is ~0.002. The pooled KS must see
   // the deviation and the report must call it quenched (not a failure of the law), and the
   // decisive one-per-sphere test must not reject.
   Scene s = preset("fig3");

@@ -119,7 +119,9 @@ TEST(Theory, CoreContactProbability) {
 TEST(Theory, QuenchedDeviationScalesAsOneOverSqrtN) {
   const double s1 = quenched_deviation_scale(1000), s2 = quenched_deviation_scale(100000);
   EXPECT_NEAR(s1 / s2, 10.0, 0.01);
-  EXPECT_NEAR(s1 * std::sqrt(1000.0), 0.42, 0.02);
+  // 0.233/sqrt(N) for exactly N centres; a Poisson number of centres would give 0.42/sqrt(N): the
+  // count fluctuation is removed (checked against 5 explicit spheres by bench/runtime_vs_error).
+  EXPECT_NEAR(s1 * std::sqrt(1000.0), 0.233, 0.005);
 }
 
 }  // namespace

@@ -62,7 +62,8 @@ namespace asperity {
 
 /// Standard deviation, over random spheres, of ONE sphere's own (quenched) cdf of r_xy at the
 /// point where the ensemble cdf equals 1 - exp(-mu) (mu = lambda pi t^2), in the flat Poisson
-/// (Boolean-model) approximation: Var = (mu/N) e^{-2 mu} G(mu), with
+/// (Boolean-model) approximation for exactly N centres: Var = (mu e^{-2 mu} G(mu) - mu^2 e^{-2 mu})/N
+/// (the second term removes the count fluctuation of a Poisson process), with
 /// G(mu) = 2 int_0^2 u (exp(mu L(u)/pi) - 1) du and L(u) the overlap area of two unit disks at
 /// distance u. Rotations of one sphere converge to that sphere's law, which differs from the
 /// ensemble law by about this much: a KS test with many more rotations than ~1/sd^2 must reject.
