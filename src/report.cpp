@@ -265,7 +265,7 @@ std::string format_table(const GeometryReport& r) {
      << sp.asperities << ", R = " << sp.radius << " m, a = " << sp.asperity_radius << " m, " << r.samples
      << " drops, seed " << r.scene.ensemble.seed << "\n";
   os << "lengths in micrometres, omega in rad/s; KS = one-sample Kolmogorov-Smirnov, alpha = " << r.scene.alpha << " per test\n\n";
-  os << std::left << std::setw(14) << "quantity" << std::setw(24) << "measured mean +- se" << std::setw(14) << "law"
+  os << std::left << std::setw(14) << "quantity" << std::setw(24) << "measured mean +- se" << std::setw(18) << "law"
      << std::setw(12) << "law mean" << std::setw(16) << "scope" << std::setw(10) << "KS D" << std::setw(11) << "p"
      << "verdict\n";
   os << std::string(112, '-') << "\n";
