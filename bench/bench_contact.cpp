@@ -119,19 +119,6 @@ std::vector<std::string> split(std::string_view s) {
   return out;
 }
 
-std::uint64_t parse_count(const std::string& s, const char* what) {
-  std::size_t pos = 0;
-  double v = 0;
-  try {
-    v = std::stod(s, &pos);
-  } catch (const std::exception&) {
-    pos = 0;
-  }
-  if (pos != s.size() || !(v >= 0) || v > 1e12 || v != std::floor(v))
-    throw std::invalid_argument(std::string(what) + ": not a count: '" + s + "'");
-  return static_cast<std::uint64_t>(v);
-}
-
 double parse_double(const std::string& s, const char* what) {
   std::size_t pos = 0;
   double v = 0;
@@ -142,6 +129,13 @@ double parse_double(const std::string& s, const char* what) {
   }
   if (pos != s.size() || !std::isfinite(v)) throw std::invalid_argument(std::string(what) + ": not a number: '" + s + "'");
   return v;
+}
+
+std::uint64_t parse_count(const std::string& s, const char* what) {
+  const double v = parse_double(s, what);
+  if (!(v >= 0) || v > 1e12 || v != std::floor(v))
+    throw std::invalid_argument(std::string(what) + ": not a count: '" + s + "'");
+  return static_cast<std::uint64_t>(v);
 }
 
 Options parse(int argc, char** argv) {
