@@ -124,7 +124,7 @@ RoughBody make_rough_sphere_body(const SphereParams& p_in, const RadiusDistribut
   b.centres.resize(p.asperities);
   b.radii.resize(p.asperities);
   const auto n = static_cast<std::int64_t>(p.asperities);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > 16384)  // small bodies: thread start-up dominates
   for (std::int64_t i = 0; i < n; ++i) {
     Stream s(seed, Purpose::sphere, sphere_id, static_cast<std::uint64_t>(i));
     const double u = s.uniform0(), v = s.uniform0();

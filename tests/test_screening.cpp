@@ -75,7 +75,9 @@ TEST(Screening, ScreenedAsperitiesNeverTouchAndKeptOnesDo) {
   EXPECT_GT(r.screened, 100u);  // the hierarchy does screen
   EXPECT_GT(r.kept, 800u);      // at least all big ones
   for (std::size_t i = 0; i < b.size(); ++i) {
-    if (b.radii[i] == 2e-6) ASSERT_NE(r.status[i], Screen::screened) << i;
+    if (b.radii[i] == 2e-6) {
+      ASSERT_NE(r.status[i], Screen::screened) << i;
+    }
   }
 
   // Global sampling: 2e5 uniform directions; no winner may be screened.
