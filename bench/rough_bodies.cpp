@@ -3,6 +3,11 @@
 //
 //   rough_bodies radii  [--n 100000] [--R 3e-3] [--levels 1.3e-6:0.2,6.5e-7:0.8] [--drops 100000]
 //                       [--bodies 2] [--seed 1] [--out DIR] [--no-plots]
+//   rough_bodies mesh   --mesh meshes/ellipsoid.off [--smooth 4e-3,3e-3,2.25e-3] [--n 100000]
+//                       [--radius 6.5e-7 | --levels ...] [--bodies 10] [--drops 100000] [--speed 1.3]
+//                       [--omega-x 0.2] [--seed 1] [--out DIR] [--no-plots]
+//   rough_bodies export --mesh meshes/rounded_cube.off --out body.ply [--n 300] [--radius 5e-5]
+//                       [--style points|spheres] [--inflate 1] [--smooth a,b,c] [--seed 1]
 #include <CLI/CLI.hpp>
 
 #include <iostream>
@@ -10,6 +15,7 @@
 #include <stdexcept>
 
 #include "asperity/body_experiments.hpp"
+#include "asperity/mesh.hpp"
 
 using namespace asperity;
 
@@ -36,6 +42,20 @@ RadiusDistribution parse_levels(const std::string& s) {
   return d;
 }
 
+std::vector<double> parse_list(const std::string& s, const std::string& what) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      v.push_back(std::stod(item));
+    } catch (const std::logic_error&) {
+      throw std::invalid_argument(what + ": not a number: '" + item + "'");
+    }
+  }
+  return v;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -56,6 +76,38 @@ int main(int argc, char** argv) {
   radii->add_option("--out", re.out, "output directory");
   radii->add_flag("--no-plots", no_plots, "no PNG figures");
 
+  MeshImpactExperiment me;
+  std::string mesh_levels, smooth;
+  double mesh_radius = 6.5e-7, omega_x = 0.2;
+  bool mesh_no_plots = false;
+  auto* mesh = app.add_subcommand("mesh", "single impacts of a rough mesh body with its full inertia tensor");
+  mesh->add_option("--mesh", me.mesh, "mesh file (OFF/PLY/STL/OBJ, metres)")->required();
+  mesh->add_option("--smooth", smooth, "a,b,c: map centres onto this ellipsoid [m]");
+  mesh->add_option("--n", me.asperities, "asperities per body");
+  mesh->add_option("--radius", mesh_radius, "asperity radius [m]");
+  mesh->add_option("--levels", mesh_levels, "radius:fraction,... [m] (instead of --radius)");
+  mesh->add_option("--bodies", me.bodies, "explicit bodies");
+  mesh->add_option("--drops", me.drops, "drops (multiple of bodies)");
+  mesh->add_option("--speed", me.speed, "impact speed [m/s]");
+  mesh->add_option("--omega-x", omega_x, "spin before [rad/s]");
+  mesh->add_option("--seed", me.seed, "seed");
+  mesh->add_option("--out", me.out, "output directory");
+  mesh->add_flag("--no-plots", mesh_no_plots, "no PNG figures");
+
+  std::filesystem::path ex_mesh, ex_out;
+  std::string ex_style = "spheres", ex_smooth;
+  std::uint64_t ex_n = 300, ex_seed = 1;
+  double ex_radius = 5e-5, ex_inflate = 1.0;
+  auto* exp = app.add_subcommand("export", "write a rough mesh body as PLY (MeshLab, ParaView)");
+  exp->add_option("--mesh", ex_mesh, "mesh file")->required();
+  exp->add_option("--out", ex_out, "PLY file")->required();
+  exp->add_option("--n", ex_n, "asperities");
+  exp->add_option("--radius", ex_radius, "asperity radius [m]");
+  exp->add_option("--style", ex_style, "points | spheres");
+  exp->add_option("--inflate", ex_inflate, "draw asperities this many times larger (visibility)");
+  exp->add_option("--smooth", ex_smooth, "a,b,c: map centres onto this ellipsoid [m]");
+  exp->add_option("--seed", ex_seed, "seed");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -67,6 +119,32 @@ int main(int argc, char** argv) {
       re.plots = !no_plots;
       const RadiiReport r = run_radii_experiment(re);
       std::cout << format_table(r);
+      return 0;
+    }
+    if (*mesh) {
+      if (!smooth.empty()) me.smooth_ellipsoid = parse_list(smooth, "--smooth");
+      me.radii = mesh_levels.empty() ? RadiusDistribution::fixed(mesh_radius) : parse_levels(mesh_levels);
+      me.omega = Vec3(omega_x, 0, 0);
+      me.plots = !mesh_no_plots;
+      const MeshImpactReport r = run_mesh_impacts(me);
+      std::cout << format_table(r);
+      return 0;
+    }
+    if (*exp) {
+      if (ex_style != "points" && ex_style != "spheres")
+        throw std::invalid_argument("--style must be points or spheres, got '" + ex_style + "'");
+      const TriangleMesh m = read_mesh(ex_mesh);
+      SurfaceMap onto;
+      if (!ex_smooth.empty()) {
+        const auto ax = parse_list(ex_smooth, "--smooth");
+        if (ax.size() != 3) throw std::invalid_argument("--smooth needs 3 semi-axes, got " + std::to_string(ax.size()));
+        onto = ellipsoid_surface(ax[0], ax[1], ax[2]);
+      }
+      const RoughBody b = make_rough_mesh_body(m, ex_n, RadiusDistribution::fixed(ex_radius), 1000, ex_seed, 0, onto,
+                                               ex_mesh.stem().string());
+      write_ply(ex_out, b, ex_style == "points" ? PlyStyle::points : PlyStyle::spheres, ex_inflate, &m,
+                -mass_properties(m, 1000).centroid);
+      std::cout << "wrote " << ex_out.string() << ": " << b.size() << " asperities of " << ex_mesh.string() << "\n";
       return 0;
     }
   } catch (const std::invalid_argument& e) {

@@ -265,3 +265,234 @@ std::string to_json(const RadiiReport& r) {
 }
 
 }  // namespace asperity
+
+#include <Eigen/Eigenvalues>
+
+#include "asperity/body_impact.hpp"
+#include "asperity/orientation.hpp"
+#include "asperity/random.hpp"
+#include "asperity/restitution.hpp"
+#include "asperity/theory_impact.hpp"
+
+namespace asperity {
+
+void validate(const MeshImpactExperiment& e) {
+  if (!std::isfinite(e.scale) || e.scale <= 0) throw std::invalid_argument("mesh scale must be finite and > 0, got " + num(e.scale));
+  if (!e.smooth_ellipsoid.empty() && e.smooth_ellipsoid.size() != 3)
+    throw std::invalid_argument("smooth ellipsoid needs 3 semi-axes, got " + std::to_string(e.smooth_ellipsoid.size()));
+  if (e.asperities < 1 || e.asperities > 0xffffffffull)
+    throw std::invalid_argument("asperities must be in [1, 2^32-1], got " + std::to_string(e.asperities));
+  validate(e.radii);
+  if (!std::isfinite(e.density) || e.density <= 0) throw std::invalid_argument("density must be finite and > 0, got " + num(e.density));
+  if (e.bodies < 1 || e.drops < 2 || e.drops % e.bodies != 0)
+    throw std::invalid_argument("drops (" + std::to_string(e.drops) + ") must be >= 2 and a multiple of bodies (" +
+                                std::to_string(e.bodies) + ")");
+  if (!std::isfinite(e.speed) || e.speed <= 0) throw std::invalid_argument("speed must be finite and > 0 m/s, got " + num(e.speed));
+  if (!e.omega.allFinite()) throw std::invalid_argument("omega must be finite");
+  if (!(e.alpha > 0 && e.alpha < 1)) throw std::invalid_argument("alpha must be in (0,1), got " + num(e.alpha));
+}
+
+MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
+  validate(e);
+  const auto t0 = std::chrono::steady_clock::now();
+  MeshImpactReport r;
+  r.experiment = e;
+  const TriangleMesh mesh = read_mesh(e.mesh, e.scale);
+  r.mass = mass_properties(mesh, e.density);
+  r.principal_moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.mass.inertia).eigenvalues();
+  SurfaceMap onto;
+  if (!e.smooth_ellipsoid.empty()) onto = ellipsoid_surface(e.smooth_ellipsoid[0], e.smooth_ellipsoid[1], e.smooth_ellipsoid[2]);
+  r.law_radius = e.smooth_ellipsoid.empty() ? std::cbrt(3.0 * r.mass.volume / (4.0 * std::numbers::pi))
+                                            : std::cbrt(e.smooth_ellipsoid[0] * e.smooth_ellipsoid[1] * e.smooth_ellipsoid[2]);
+  const auto eps_n = viscoelastic_pade14(e.beta);
+  const std::uint64_t M = e.drops / e.bodies;
+  const std::size_t n = e.drops;
+  std::vector<double> rx(n), ry(n), rz(n), rxy(n), eps(n, kNaN), wx(n, kNaN);
+  std::vector<std::uint8_t> core(n, 0), hit(n, 0);
+  const std::string name = e.mesh.stem().string();
+  for (std::uint64_t k = 0; k < e.bodies; ++k) {
+    const RoughBody b = make_rough_mesh_body(mesh, e.asperities, e.radii, e.density, e.seed, k, onto, name);
+    if (k == 0) r.mass.area = b.area;
+    const auto q = make_support_tree(b.centres, b.radii);
+    const auto m = static_cast<std::int64_t>(M);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t j = 0; j < m; ++j) {
+      const std::uint64_t drop = k * M + static_cast<std::uint64_t>(j);
+      Stream st(e.seed, Purpose::orientation, drop);
+      const Rotation rot = random_rotation(st);
+      const BodyImpact bi = body_impact(b, *q, rot, Vec3(0, 0, -e.speed), e.omega, *eps_n, e.eps_t);
+      const Vec3& c = bi.contact.r;
+      rx[drop] = c.x(), ry[drop] = c.y(), rz[drop] = c.z(), rxy[drop] = std::hypot(c.x(), c.y());
+      // Base surface support below the centre of mass: the ellipsoid's, or the mesh's (a vertex).
+      const Vec3 d = body_down(rot);
+      double h_base = -std::numeric_limits<double>::infinity();
+      if (!e.smooth_ellipsoid.empty()) {
+        const double a = e.smooth_ellipsoid[0], bb = e.smooth_ellipsoid[1], cc = e.smooth_ellipsoid[2];
+        // Support of the ellipsoid (centred at the mesh origin) measured from the centre of mass.
+        h_base = std::sqrt(a * a * d.x() * d.x() + bb * bb * d.y() * d.y() + cc * cc * d.z() * d.z()) - r.mass.centroid.dot(d);
+      } else {
+        for (const Vec3& v : mesh.vertices) h_base = std::max(h_base, (v - r.mass.centroid).dot(d));
+      }
+      core[drop] = -c.z() < h_base;
+      if (bi.result) {
+        hit[drop] = 1;
+        eps[drop] = bi.result->eps;
+        wx[drop] = bi.result->Omega_after.x();
+      }
+    }
+  }
+  r.samples = n;
+  for (std::size_t i = 0; i < n; ++i) r.no_impacts += !hit[i], r.core_contacts += core[i];
+  std::vector<double> e_ok, w_ok;
+  for (std::size_t i = 0; i < n; ++i)
+    if (hit[i]) e_ok.push_back(eps[i]), w_ok.push_back(wx[i]);
+
+  const std::vector<double> probs{0.01, 0.5, 0.99};
+  const std::size_t K = e.bodies >= 2 ? e.bodies : 1;
+  auto summary = [&](const std::vector<double>& x, bool per_drop) {
+    return per_drop && K >= 2 ? summarize_batches(x, K, probs) : summarize_iid(x, probs);
+  };
+  r.quantities.push_back({"r_x", summary(rx, true)});
+  r.quantities.push_back({"r_y", summary(ry, true)});
+  r.quantities.push_back({"r_z", summary(rz, true)});
+  r.quantities.push_back({"r_xy", summary(rxy, true)});
+  if (e_ok.size() >= 2) {
+    r.quantities.push_back({"eps", summary(e_ok, e_ok.size() == n)});
+    r.quantities.push_back({"omega_x_after", summary(w_ok, w_ok.size() == n)});
+  }
+
+  // The paper's sphere laws for the comparison sphere (same areal density of asperities).
+  const double Rl = r.law_radius;
+  r.law_asperities = static_cast<std::uint64_t>(std::llround(static_cast<double>(e.asperities) * 4.0 * std::numbers::pi * Rl * Rl / r.mass.area));
+  const std::string pooled = "pooled over " + std::to_string(e.bodies) + " bodies x " + std::to_string(M) +
+                             " rotations: p assumes iid";
+  const auto srx = sorted_copy(rx);
+  const Law l18 = eq18_rx(r.law_asperities, Rl);
+  r.tests.push_back(ks_check("r_x", srx, l18, areal_density(r.law_asperities, Rl), e.alpha, false, "Eq. 18, " + pooled));
+  r.tests.push_back(ks_check("r_x", srx, eq18_rx(r.law_asperities, Rl, 1.05), kNaN, e.alpha, true, "Eq. 18 stretched by 5%: must be rejected"));
+  ImpactScene sc;
+  sc.asperities = r.law_asperities;
+  sc.radius = Rl;
+  sc.asperity_radius = e.radii.kind == RadiusDistribution::Kind::fixed ? e.radii.radius
+                       : e.radii.kind == RadiusDistribution::Kind::lognormal ? e.radii.median
+                                                                             : e.radii.levels.front();
+  sc.speed = e.speed;
+  sc.omega_x = e.omega.x();
+  sc.omega_y = e.omega.y();
+  sc.beta = e.beta;
+  const bool sec4 = e.eps_t == 1.0 && e.omega.z() == 0.0 && e_ok.size() >= 2;
+  std::vector<Law> eps_laws;
+  if (sec4) {
+    const auto se = sorted_copy(e_ok), sw = sorted_copy(w_ok);
+    eps_laws.push_back(eq28_corrected(sc));
+    r.tests.push_back(ks_check("eps", se, eps_laws.back(), kNaN, e.alpha, false, "Eq. 28 corrected, " + pooled));
+    r.tests.push_back(ks_check("eps", se, eq28_corrected(sc, 1.05), kNaN, e.alpha, true, "alpha x 1.05: must be rejected"));
+    r.tests.push_back(ks_check("omega_x_after", sw, eq33_corrected(sc), kNaN, e.alpha, false, "Eq. 33 corrected, " + pooled));
+  }
+  std::filesystem::create_directories(e.out);
+  if (e.plots && plotting_available()) {
+    std::ostringstream sub;
+    sub << name << (e.smooth_ellipsoid.empty() ? " (facets)" : " (smooth)") << ", N = " << e.asperities << ", "
+        << e.radii.describe() << ", " << e.bodies << " x " << M;
+    {
+      const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * areal_density(r.law_asperities, Rl));
+      auto v = srx;
+      double hi = std::max(4.0 * sigma, std::max(std::abs(quantile_sorted(v, 0.001)), std::abs(quantile_sorted(v, 0.999))));
+      HistogramFigure fig;
+      fig.title = "r_x: " + sub.str();
+      fig.xlabel = "r_x [{/Symbol m}m]";
+      fig.ylabel = "probability density [1/{/Symbol m}m]";
+      fig.x_scale = 1e6;
+      fig.y_scale = 1e-6;
+      fig.histogram = make_histogram(rx, -hi, hi, 80);
+      fig.curves.push_back(curve_of(l18, "Eq. (18), sphere of equal volume, same {/Symbol l}", -hi, hi));
+      write_histogram_png(e.out / "r_x.png", fig);
+      r.plots.push_back("r_x.png");
+    }
+    if (sec4) {
+      auto v = sorted_copy(e_ok);
+      double lo = quantile_sorted(v, 1e-3), hi = quantile_sorted(v, 1.0);
+      const auto par = impact_law_parameters(sc);
+      lo = std::min(lo, par.eps_max - 6 * (par.eps_max - par.eps_n + 1e-3));
+      hi = std::max(hi, par.eps_max) + 0.02 * (hi - lo);
+      HistogramFigure fig;
+      fig.title = "{/Symbol e}: " + sub.str();
+      fig.xlabel = "{/Symbol e}";
+      fig.histogram = make_histogram(e_ok, lo, hi, 80);
+      fig.curves.push_back(curve_of(eps_laws.front(), "Eq. (28) corrected, sphere of equal volume", lo, hi));
+      write_histogram_png(e.out / "eps.png", fig);
+      r.plots.push_back("eps.png");
+    }
+  }
+  r.seconds = seconds_since(t0);
+  write_file_atomic(e.out / "report.json", to_json(r));
+  write_file_atomic(e.out / "report.txt", format_table(r));
+  return r;
+}
+
+std::string format_table(const MeshImpactReport& r) {
+  std::ostringstream os;
+  const auto& e = r.experiment;
+  os << std::setprecision(4);
+  os << "mesh body " << e.mesh.string() << (e.smooth_ellipsoid.empty() ? " (centres on the facets)" : " (centres on the smooth ellipsoid)")
+     << ": N = " << e.asperities << ", radii " << e.radii.describe() << ", " << e.bodies << " bodies x "
+     << e.drops / e.bodies << " rotations\n";
+  os << "mass " << r.mass.mass << " kg, volume " << r.mass.volume << " m^3, area " << r.mass.area
+     << " m^2, principal moments " << r.principal_moments.transpose() << " kg m^2\n";
+  os << "comparison sphere: R = " << r.law_radius << " m, N = " << r.law_asperities << " (same areal density)\n";
+  os << "drops " << r.samples << ", no impact " << r.no_impacts << ", base surface lower than every asperity "
+     << r.core_contacts << "\n";
+  os << std::left << std::setw(15) << "quantity" << std::setw(24) << "mean +- se" << std::setw(13) << "std" << "q01 / q50 / q99\n";
+  for (const auto& q : r.quantities) {
+    std::ostringstream m;
+    m << std::setprecision(5) << q.summary.mean.value << " +- " << std::setprecision(2) << q.summary.mean.se;
+    os << std::setw(15) << q.name << std::setw(24) << m.str() << std::setw(13) << q.summary.std.value;
+    for (const auto& x : q.summary.quantiles) os << x.value << " ";
+    os << "\n";
+  }
+  os << std::setw(15) << "quantity" << std::setw(28) << "law" << std::setw(11) << "KS D" << std::setw(11) << "p" << "verdict\n";
+  for (const auto& t : r.tests)
+    os << std::setw(15) << t.quantity << std::setw(28) << t.law << std::setw(11) << t.ks.D << std::setw(11) << t.ks.p << t.verdict
+       << (t.power_check ? " (power check: must reject)" : "") << "\n";
+  return os.str();
+}
+
+std::string to_json(const MeshImpactReport& r) {
+  nlohmann::json j;
+  const auto& e = r.experiment;
+  j["schema_version"] = kReportSchemaVersion;
+  j["experiment"] = "mesh-impacts";
+  j["mesh"] = e.mesh.string();
+  j["smooth_ellipsoid"] = e.smooth_ellipsoid;
+  j["asperities"] = e.asperities;
+  j["radii"] = e.radii.describe();
+  j["bodies"] = e.bodies;
+  j["drops"] = e.drops;
+  j["speed"] = e.speed;
+  j["omega"] = {e.omega.x(), e.omega.y(), e.omega.z()};
+  j["seed"] = e.seed;
+  j["mass"] = {{"mass", r.mass.mass},
+               {"volume", r.mass.volume},
+               {"area", r.mass.area},
+               {"centroid", {r.mass.centroid.x(), r.mass.centroid.y(), r.mass.centroid.z()}},
+               {"principal_moments", {r.principal_moments.x(), r.principal_moments.y(), r.principal_moments.z()}}};
+  j["law_radius"] = r.law_radius;
+  j["law_asperities"] = r.law_asperities;
+  j["samples"] = r.samples;
+  j["no_impacts"] = r.no_impacts;
+  j["core_contacts"] = r.core_contacts;
+  j["quantities"] = nlohmann::json::array();
+  for (const auto& q : r.quantities)
+    j["quantities"].push_back({{"name", q.name},
+                               {"n", q.summary.n},
+                               {"mean", json_of(q.summary.mean)},
+                               {"std", json_of(q.summary.std)},
+                               {"batches", q.summary.batches}});
+  j["tests"] = nlohmann::json::array();
+  for (const auto& t : r.tests) j["tests"].push_back(json_of(t));
+  j["plots"] = r.plots;
+  j["seconds"] = r.seconds;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace asperity
