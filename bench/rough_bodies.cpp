@@ -16,6 +16,12 @@
 
 #include "asperity/body_experiments.hpp"
 #include "asperity/mesh.hpp"
+#include "asperity/random.hpp"
+#include "asperity/support.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
 
 using namespace asperity;
 
@@ -54,6 +60,49 @@ std::vector<double> parse_list(const std::string& s, const std::string& what) {
     }
   }
   return v;
+}
+
+// Single-threaded ns per query of the support tree and of brute_support on a two-level rough
+// sphere; every tree answer is checked against brute force on the brute-force subset.
+void support_bench(const std::vector<std::uint64_t>& ns, std::uint64_t queries, int repeats) {
+  std::cout << "| N | tree ns/query | brute ns/query | speed-up | tree build ms | tree MB |\n|---|---|---|---|---|---|\n";
+  for (std::uint64_t n : ns) {
+    SphereParams p;
+    p.asperities = n;
+    const RoughBody b = make_rough_sphere_body(p, RadiusDistribution::discrete({1.3e-6, 6.5e-7}, {0.2, 0.8}), 1, 0);
+    std::vector<Vec3> d(queries);
+    for (std::uint64_t k = 0; k < queries; ++k) {
+      Stream s(2, Purpose::analysis, k);
+      d[k] = uniform_on_sphere(s.uniform0(), s.uniform0());
+    }
+    using clock = std::chrono::steady_clock;
+    std::vector<double> build, tree, brute;
+    std::unique_ptr<SupportQuery> q;
+    std::uint64_t sink = 0;
+    const std::uint64_t brute_q = std::max<std::uint64_t>(1, std::min<std::uint64_t>(queries, 2e8 / static_cast<double>(n)));
+    for (int r = 0; r < repeats; ++r) {
+      auto t0 = clock::now();
+      q = make_support_tree(b.centres, b.radii);
+      build.push_back(std::chrono::duration<double>(clock::now() - t0).count() * 1e3);
+      t0 = clock::now();
+      for (const Vec3& x : d) sink += q->support(x).index;
+      tree.push_back(std::chrono::duration<double>(clock::now() - t0).count() * 1e9 / static_cast<double>(queries));
+      t0 = clock::now();
+      for (std::uint64_t k = 0; k < brute_q; ++k) {
+        const Support want = brute_support(b.centres, b.radii, d[k]);
+        sink += want.index;
+        if (r == 0 && !(q->support(d[k]) == want)) throw std::runtime_error("support tree differs from brute force");
+      }
+      brute.push_back(std::chrono::duration<double>(clock::now() - t0).count() * 1e9 / static_cast<double>(brute_q));
+    }
+    auto med = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    std::cout << "| " << n << " | " << med(tree) << " | " << med(brute) << " | " << med(brute) / med(tree) << " | "
+              << med(build) << " | " << static_cast<double>(q->memory_bytes()) / 1e6 << " |\n";
+    if (sink == 42) std::cout << "";
+  }
 }
 
 }  // namespace
@@ -108,6 +157,14 @@ int main(int argc, char** argv) {
   exp->add_option("--smooth", ex_smooth, "a,b,c: map centres onto this ellipsoid [m]");
   exp->add_option("--seed", ex_seed, "seed");
 
+  std::vector<std::uint64_t> sb_n{10000, 100000, 1000000};
+  std::uint64_t sb_queries = 20000;
+  int sb_repeats = 5;
+  auto* sbench = app.add_subcommand("support-bench", "time the exact support query (tree vs brute), medians");
+  sbench->add_option("--n", sb_n, "asperity counts");
+  sbench->add_option("--queries", sb_queries, "queries per repeat");
+  sbench->add_option("--repeats", sb_repeats, "repeats (median reported)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -128,6 +185,10 @@ int main(int argc, char** argv) {
       me.plots = !mesh_no_plots;
       const MeshImpactReport r = run_mesh_impacts(me);
       std::cout << format_table(r);
+      return 0;
+    }
+    if (*sbench) {
+      support_bench(sb_n, sb_queries, sb_repeats);
       return 0;
     }
     if (*exp) {

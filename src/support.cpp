@@ -135,6 +135,10 @@ class Tree final : public SupportQuery {
   struct Node {
     double lo[3], hi[3];
     double rho_max;
+    Vec3 axis{0, 0, 1};        // cone of centre directions (valid when cone)
+    double cphi = 1, sphi = 0; // cos, sin of its padded half-angle (< 90 degrees)
+    double rmin = 0, rmax = 0; // range of |c| [m], padded
+    bool cone = false;
     std::uint32_t begin, end;
     std::uint32_t left = 0;  // children at left, left+1; 0 = leaf (the root is never a child)
   };
@@ -147,6 +151,21 @@ class Tree final : public SupportQuery {
   double bound(const Node& nd, const Vec3& d) const {
     double s = 0;
     for (int k = 0; k < 3; ++k) s += std::max(nd.lo[k] * d[k], nd.hi[k] * d[k]);
+    if (nd.cone) {
+      // Every centre direction u lies within angle phi of the axis a, so for theta = angle(a, d)
+      // u.d <= cos(max(0, theta - phi)) = cos(theta) cos(phi) + sin(theta) sin(phi) when theta > phi.
+      // A box around a tilted surface patch sticks out to first order in the patch size; the
+      // cone only to second order, which is what keeps the search local on curved bodies.
+      const double ct = nd.axis.dot(d), st = nd.axis.cross(d).norm();
+      double cone;
+      if (st * nd.cphi - ct * nd.sphi <= 0 && ct * nd.cphi + st * nd.sphi >= 0) {
+        cone = nd.rmax;
+      } else {
+        const double c = ct * nd.cphi + st * nd.sphi;
+        cone = (c >= 0 ? nd.rmax : nd.rmin) * c;
+      }
+      s = std::min(s, cone);
+    }
     return s + nd.rho_max + margin_;
   }
 
@@ -158,10 +177,39 @@ class Tree final : public SupportQuery {
     nd.end = end;
     nd.rho_max = -kInf;
     for (int k = 0; k < 3; ++k) nd.lo[k] = kInf, nd.hi[k] = -kInf;
+    Vec3 mean = Vec3::Zero();
+    bool at_origin = false;
+    nd.rmin = kInf;
     for (std::uint32_t j = begin; j < end; ++j) {
       const Vec3& p = c[perm[j]];
       for (int k = 0; k < 3; ++k) nd.lo[k] = std::min(nd.lo[k], p[k]), nd.hi[k] = std::max(nd.hi[k], p[k]);
       nd.rho_max = std::max(nd.rho_max, r[perm[j]]);
+      const double len = p.norm();
+      nd.rmin = std::min(nd.rmin, len);
+      nd.rmax = std::max(nd.rmax, len);
+      if (len > 0) mean += p / len;
+      else at_origin = true;
+    }
+    if (!at_origin && mean.norm() > 0) {
+      nd.axis = mean.normalized();
+      // Half-angle from the largest sine while every centre is within 90 degrees of the axis
+      // (asin is accurate for small angles, where acos of the smallest cosine is not).
+      double smax = 0, cmin = 1;
+      for (std::uint32_t j = begin; j < end; ++j) {
+        const Vec3& p = c[perm[j]];
+        const double len = p.norm();
+        smax = std::max(smax, nd.axis.cross(p).norm() / len);
+        cmin = std::min(cmin, nd.axis.dot(p) / len);
+      }
+      // Pad the angle and radii well beyond rounding (angles to ~1e-16 rad, lengths to ~1e-16 relative).
+      const double phi = std::asin(std::min(1.0, smax)) + 1e-12;
+      if (cmin > 1e-6 && phi < 1.5) {
+        nd.cone = true;
+        nd.cphi = std::cos(phi);
+        nd.sphi = std::sin(phi);
+        nd.rmax *= 1 + 1e-13;
+        nd.rmin *= 1 - 1e-13;
+      }
     }
     if (end - begin > kLeaf) {
       int axis = 0;
