@@ -118,6 +118,8 @@ int main(int argc, char** argv) {
   radii->add_option("--n", re.asperities, "asperities N");
   radii->add_option("--R", re.radius, "sphere radius [m]");
   radii->add_option("--levels", levels, "radius:fraction,... [m]");
+  std::string lognormal;
+  radii->add_option("--lognormal", lognormal, "median,sigma: lognormal radii (explicit bodies; instead of --levels)");
   radii->add_option("--drops", re.drops, "fresh drops");
   radii->add_option("--bodies", re.screen_bodies, "explicit spheres screened for lambda_eff");
   radii->add_option("--directions", re.screen_directions, "random directions of the screening cross-check per body");
@@ -172,7 +174,13 @@ int main(int argc, char** argv) {
   }
   try {
     if (*radii) {
-      re.radii = parse_levels(levels);
+      if (lognormal.empty()) {
+        re.radii = parse_levels(levels);
+      } else {
+        const auto v = parse_list(lognormal, "--lognormal");
+        if (v.size() != 2) throw std::invalid_argument("--lognormal needs median,sigma, got '" + lognormal + "'");
+        re.radii = RadiusDistribution::lognormal(v[0], v[1]);
+      }
       re.plots = !no_plots;
       const RadiiReport r = run_radii_experiment(re);
       std::cout << format_table(r);

@@ -19,6 +19,8 @@
 #include "asperity/support.hpp"
 #include "asperity/theory.hpp"
 #include "asperity/theory_radii.hpp"
+#include "asperity/orientation.hpp"
+#include "asperity/random.hpp"
 
 namespace asperity {
 namespace {
@@ -75,12 +77,57 @@ void validate(const RadiiExperiment& e) {
   if (!std::isfinite(e.radius) || e.radius <= 0)
     throw std::invalid_argument("radius must be a finite number > 0 m, got " + num(e.radius));
   validate(e.radii);
-  if (e.radii.kind == RadiusDistribution::Kind::lognormal)
-    throw std::invalid_argument("radii: the radii experiment needs fixed or level radii (exact law), got " +
-                                e.radii.describe());
+  if (e.radii.kind == RadiusDistribution::Kind::lognormal && (e.screen_bodies < 1 || e.drops % e.screen_bodies != 0))
+    throw std::invalid_argument("lognormal radii: r_x comes from the screened bodies, so drops (" + std::to_string(e.drops) +
+                                ") must be a multiple of bodies (" + std::to_string(e.screen_bodies) + " >= 1)");
   if (e.drops < 2) throw std::invalid_argument("drops must be >= 2, got " + std::to_string(e.drops));
   if (!(e.alpha > 0 && e.alpha < 1)) throw std::invalid_argument("alpha must be in (0,1), got " + num(e.alpha));
 }
+
+namespace {
+// Lognormal radii: Gaussian laws only (no exact law), from explicit bodies; a 5%-wider Gaussian
+// with the fitted variance is the power check.
+RadiiReport finish_lognormal(const RadiiExperiment& e, RadiiReport& r, const std::vector<double>& rx,
+                             const std::vector<double>& rxy) {
+  const Summary sx = summarize_batches(rx, e.screen_bodies >= 2 ? e.screen_bodies : 1, std::vector<double>{0.5});
+  r.rx_std = sx.std;
+  r.lambda_fit = 1.0 / (2.0 * std::numbers::pi * sx.std.value * sx.std.value);
+  const auto srx = sorted_copy(rx);
+  const std::string pooled = "pooled over " + std::to_string(e.screen_bodies) + " bodies x rotations: p assumes iid";
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda, "gauss-lambda"), r.lambda, e.alpha, false, "Eq. 18, all asperities; " + pooled));
+  if (r.lambda_eff.value > 0)
+    r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_eff.value, "gauss-lambda-eff"), r.lambda_eff.value, e.alpha, false,
+                               "Eq. 18 with lambda_eff; " + pooled));
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_fit, "gauss-lambda-fit"), r.lambda_fit, e.alpha, false,
+                             "Gaussian with the sample variance (fitted: p is optimistic)"));
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_fit / (1.05 * 1.05), "gauss-lambda-fit-x1.05"), kNaN, e.alpha, true,
+                             "fitted Gaussian 5% wider: must be rejected"));
+  std::filesystem::create_directories(e.out);
+  if (e.plots && plotting_available()) {
+    const double hi = 4.5 / std::sqrt(2.0 * std::numbers::pi * r.lambda_fit);
+    HistogramFigure fig;
+    std::ostringstream t;
+    t << "r_x, N = " << e.asperities << ", radii " << e.radii.describe() << ", " << rx.size() << " drops of " << e.screen_bodies
+      << " spheres";
+    fig.title = t.str();
+    fig.xlabel = "r_x [{/Symbol m}m]";
+    fig.ylabel = "probability density [1/{/Symbol m}m]";
+    fig.x_scale = 1e6;
+    fig.y_scale = 1e-6;
+    fig.histogram = make_histogram(rx, -hi, hi, 60);
+    fig.curves.push_back(curve_of(gaussian_rx(r.lambda, "g"), "Eq. (18), {/Symbol l} of all asperities", -hi, hi));
+    if (r.lambda_eff.value > 0)
+      fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), {/Symbol l}_{eff} (screening)", -hi, hi));
+    fig.curves.push_back(curve_of(gaussian_rx(r.lambda_fit, "g"), "Gaussian, fitted variance", -hi, hi));
+    write_histogram_png(e.out / "r_x.png", fig);
+    r.plots.push_back("r_x.png");
+  }
+  (void)rxy;
+  write_file_atomic(e.out / "report.json", to_json(r));
+  write_file_atomic(e.out / "report.txt", format_table(r));
+  return r;
+}
+}  // namespace
 
 RadiiReport run_radii_experiment(const RadiiExperiment& e) {
   validate(e);
@@ -88,12 +135,23 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
   r.experiment = e;
   const double R = e.radius, area = 4.0 * std::numbers::pi * R * R;
   r.lambda = static_cast<double>(e.asperities) / area;
+  const bool lognormal = e.radii.kind == RadiusDistribution::Kind::lognormal;
   std::vector<double> lv = e.radii.kind == RadiusDistribution::Kind::levels ? e.radii.levels
-                                                                            : std::vector<double>{e.radii.radius};
+                           : lognormal                                       ? std::vector<double>{}
+                                                                             : std::vector<double>{e.radii.radius};
   std::vector<double> fr = e.radii.kind == RadiusDistribution::Kind::levels ? e.radii.fractions
-                                                                            : std::vector<double>{1.0};
-  const std::size_t top = static_cast<std::size_t>(std::max_element(lv.begin(), lv.end()) - lv.begin());
-  r.lambda_top = r.lambda * fr[top];
+                           : lognormal                                       ? std::vector<double>{}
+                                                                             : std::vector<double>{1.0};
+  if (!lv.empty()) {
+    const std::size_t top = static_cast<std::size_t>(std::max_element(lv.begin(), lv.end()) - lv.begin());
+    r.lambda_top = r.lambda * fr[top];
+  } else {
+    r.lambda_top = kNaN;
+  }
+  // Lognormal radii have no exact law here: r_x then comes from M rotations of each screened body
+  // (Stream(seed, orientation, k M + j)), like the "fixed" ensemble.
+  const std::uint64_t M = lognormal ? e.drops / e.screen_bodies : 0;
+  std::vector<double> rx_explicit, rxy_explicit;
 
   // (1) Screening of explicit bodies.
   auto t0 = std::chrono::steady_clock::now();
@@ -116,6 +174,20 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
     r.winners_screened += c.winners_screened;
     r.kept_never_hit += c.kept_never_hit;
     r.directions += c.directions;
+    if (lognormal) {
+      const auto m = static_cast<std::int64_t>(M);
+      const std::size_t base = rx_explicit.size();
+      rx_explicit.resize(base + M);
+      rxy_explicit.resize(base + M);
+#pragma omp parallel for schedule(static)
+      for (std::int64_t j = 0; j < m; ++j) {
+        Stream st(e.seed, Purpose::orientation, k * M + static_cast<std::uint64_t>(j));
+        const Rotation rot = random_rotation(st);
+        const BodyContact bc = make_body_contact(q->support(body_down(rot)), b, rot);
+        rx_explicit[base + static_cast<std::size_t>(j)] = bc.r.x();
+        rxy_explicit[base + static_cast<std::size_t>(j)] = std::hypot(bc.r.x(), bc.r.y());
+      }
+    }
     for (std::size_t i = 0; i < b.size(); ++i) {
       const std::size_t m = static_cast<std::size_t>(std::find(lv.begin(), lv.end(), b.radii[i]) - lv.begin());
       if (m >= lv.size()) continue;
@@ -133,6 +205,8 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
     r.lambda_eff.se = lam_eff.size() > 1 ? std::sqrt(v / static_cast<double>(lam_eff.size() - 1) / static_cast<double>(lam_eff.size())) : kNaN;
   }
   r.seconds_screen = seconds_since(t0);
+
+  if (lognormal) return finish_lognormal(e, r, rx_explicit, rxy_explicit);
 
   // (2) Fresh drops: iid, each a pure function of (seed, drop).
   t0 = std::chrono::steady_clock::now();
@@ -221,13 +295,17 @@ std::string format_table(const RadiiReport& r) {
      << r.seconds_screen << " s\n";
   os << "cross-check: " << r.directions << " random directions, winners screened " << r.winners_screened
      << ", kept but never hit " << r.kept_never_hit << "\n";
-  os << "fresh drops: " << e.drops << ", touching level fractions:";
-  for (double f : r.winner_level_fraction) os << " " << f;
+  if (e.radii.kind == RadiusDistribution::Kind::lognormal) {
+    os << "drops: " << e.drops << " (rotations of the screened spheres)";
+  } else {
+    os << "fresh drops: " << e.drops << ", touching level fractions:";
+    for (double f : r.winner_level_fraction) os << " " << f;
+  }
   os << ", core contacts " << r.core_contacts << ", std(r_x) = " << r.rx_std.value << " +- " << r.rx_std.se << " m\n";
-  os << std::left << std::setw(6) << "qty" << std::setw(20) << "law" << std::setw(13) << "lambda" << std::setw(11) << "KS D"
+  os << std::left << std::setw(6) << "qty" << std::setw(24) << "law" << std::setw(13) << "lambda" << std::setw(11) << "KS D"
      << std::setw(11) << "p" << "verdict\n";
   for (const auto& t : r.tests) {
-    os << std::setw(6) << t.quantity << std::setw(20) << t.law << std::setw(13) << t.lambda << std::setw(11) << t.ks.D
+    os << std::setw(6) << t.quantity << std::setw(24) << t.law << std::setw(13) << t.lambda << std::setw(11) << t.ks.D
        << std::setw(11) << t.ks.p << t.verdict << (t.power_check ? " (power check: must reject)" : "") << "\n";
   }
   return os.str();
