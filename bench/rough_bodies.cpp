@@ -3,7 +3,7 @@
 //
 //   rough_bodies radii  [--n 100000] [--R 3e-3] [--levels 1.3e-6:0.2,6.5e-7:0.8] [--drops 100000]
 //                       [--bodies 2] [--seed 1] [--out DIR] [--no-plots]
-//   rough_bodies mesh   --mesh meshes/ellipsoid.off [--smooth 4e-3,3e-3,2.25e-3] [--n 100000]
+//   rough_bodies mesh   --mesh meshes/ellipsoid.off [--smooth 4e-3,3e-3,2.25e-3[,m]] [--n 100000]
 //                       [--radius 6.5e-7 | --levels ...] [--bodies 10] [--drops 100000] [--speed 1.3]
 //                       [--omega-x 0.2] [--seed 1] [--out DIR] [--no-plots]
 //   rough_bodies export --mesh meshes/rounded_cube.off --out body.ply [--n 300] [--radius 5e-5]
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
   bool mesh_no_plots = false;
   auto* mesh = app.add_subcommand("mesh", "single impacts of a rough mesh body with its full inertia tensor");
   mesh->add_option("--mesh", me.mesh, "mesh file (OFF/PLY/STL/OBJ, metres)")->required();
-  mesh->add_option("--smooth", smooth, "a,b,c: map centres onto this ellipsoid [m]");
+  mesh->add_option("--smooth", smooth, "a,b,c[,m]: map centres onto |x/a|^m+|y/b|^m+|z/c|^m = 1 [m] (m = 2)");
   mesh->add_option("--n", me.asperities, "asperities per body");
   mesh->add_option("--radius", mesh_radius, "asperity radius [m]");
   mesh->add_option("--levels", mesh_levels, "radius:fraction,... [m] (instead of --radius)");
@@ -206,8 +206,9 @@ int main(int argc, char** argv) {
       SurfaceMap onto;
       if (!ex_smooth.empty()) {
         const auto ax = parse_list(ex_smooth, "--smooth");
-        if (ax.size() != 3) throw std::invalid_argument("--smooth needs 3 semi-axes, got " + std::to_string(ax.size()));
-        onto = ellipsoid_surface(ax[0], ax[1], ax[2]);
+        if (ax.size() != 3 && ax.size() != 4)
+          throw std::invalid_argument("--smooth needs a,b,c[,m], got " + std::to_string(ax.size()) + " numbers");
+        onto = superellipsoid_surface(ax[0], ax[1], ax[2], ax.size() == 4 ? ax[3] : 2.0);
       }
       const RoughBody b = make_rough_mesh_body(m, ex_n, RadiusDistribution::fixed(ex_radius), 1000, ex_seed, 0, onto,
                                                ex_mesh.stem().string());

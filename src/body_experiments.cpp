@@ -356,8 +356,9 @@ namespace asperity {
 
 void validate(const MeshImpactExperiment& e) {
   if (!std::isfinite(e.scale) || e.scale <= 0) throw std::invalid_argument("mesh scale must be finite and > 0, got " + num(e.scale));
-  if (!e.smooth_ellipsoid.empty() && e.smooth_ellipsoid.size() != 3)
-    throw std::invalid_argument("smooth ellipsoid needs 3 semi-axes, got " + std::to_string(e.smooth_ellipsoid.size()));
+  if (!e.smooth_ellipsoid.empty() && e.smooth_ellipsoid.size() != 3 && e.smooth_ellipsoid.size() != 4)
+    throw std::invalid_argument("smooth surface needs 3 semi-axes and an optional exponent, got " +
+                                std::to_string(e.smooth_ellipsoid.size()) + " numbers");
   if (e.asperities < 1 || e.asperities > 0xffffffffull)
     throw std::invalid_argument("asperities must be in [1, 2^32-1], got " + std::to_string(e.asperities));
   validate(e.radii);
@@ -379,9 +380,13 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
   r.mass = mass_properties(mesh, e.density);
   r.principal_moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.mass.inertia).eigenvalues();
   SurfaceMap onto;
-  if (!e.smooth_ellipsoid.empty()) onto = ellipsoid_surface(e.smooth_ellipsoid[0], e.smooth_ellipsoid[1], e.smooth_ellipsoid[2]);
-  r.law_radius = e.smooth_ellipsoid.empty() ? std::cbrt(3.0 * r.mass.volume / (4.0 * std::numbers::pi))
-                                            : std::cbrt(e.smooth_ellipsoid[0] * e.smooth_ellipsoid[1] * e.smooth_ellipsoid[2]);
+  const double sm_m = e.smooth_ellipsoid.size() == 4 ? e.smooth_ellipsoid[3] : 2.0;
+  if (!e.smooth_ellipsoid.empty())
+    onto = superellipsoid_surface(e.smooth_ellipsoid[0], e.smooth_ellipsoid[1], e.smooth_ellipsoid[2], sm_m);
+  // Comparison sphere: equal volume (the mesh's, or the smooth ellipsoid's).
+  r.law_radius = e.smooth_ellipsoid.empty() || sm_m != 2.0
+                     ? std::cbrt(3.0 * r.mass.volume / (4.0 * std::numbers::pi))
+                     : std::cbrt(e.smooth_ellipsoid[0] * e.smooth_ellipsoid[1] * e.smooth_ellipsoid[2]);
   const auto eps_n = viscoelastic_pade14(e.beta);
   const std::uint64_t M = e.drops / e.bodies;
   const std::size_t n = e.drops;
@@ -404,11 +409,12 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
       // Base surface support below the centre of mass: the ellipsoid's, or the mesh's (a vertex).
       const Vec3 d = body_down(rot);
       double h_base = -std::numeric_limits<double>::infinity();
-      if (!e.smooth_ellipsoid.empty()) {
+      if (!e.smooth_ellipsoid.empty() && sm_m == 2.0) {
         const double a = e.smooth_ellipsoid[0], bb = e.smooth_ellipsoid[1], cc = e.smooth_ellipsoid[2];
         // Support of the ellipsoid (centred at the mesh origin) measured from the centre of mass.
         h_base = std::sqrt(a * a * d.x() * d.x() + bb * bb * d.y() * d.y() + cc * cc * d.z() * d.z()) - r.mass.centroid.dot(d);
       } else {
+        // The mesh's support is a vertex; for a smooth superellipsoid (vertices on it) a lower bound.
         for (const Vec3& v : mesh.vertices) h_base = std::max(h_base, (v - r.mass.centroid).dot(d));
       }
       core[drop] = -c.z() < h_base;
@@ -512,7 +518,7 @@ std::string format_table(const MeshImpactReport& r) {
   std::ostringstream os;
   const auto& e = r.experiment;
   os << std::setprecision(4);
-  os << "mesh body " << e.mesh.string() << (e.smooth_ellipsoid.empty() ? " (centres on the facets)" : " (centres on the smooth ellipsoid)")
+  os << "mesh body " << e.mesh.string() << (e.smooth_ellipsoid.empty() ? " (centres on the facets)" : " (centres on the smooth surface)")
      << ": N = " << e.asperities << ", radii " << e.radii.describe() << ", " << e.bodies << " bodies x "
      << e.drops / e.bodies << " rotations\n";
   os << "mass " << r.mass.mass << " kg, volume " << r.mass.volume << " m^3, area " << r.mass.area

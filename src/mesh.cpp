@@ -97,6 +97,17 @@ SurfaceMap ellipsoid_surface(double a, double b, double c) {
   };
 }
 
+SurfaceMap superellipsoid_surface(double a, double b, double c, double m) {
+  for (double v : {a, b, c})
+    if (!std::isfinite(v) || v <= 0) throw std::invalid_argument("superellipsoid semi-axis must be finite and > 0 m, got " + num(v));
+  if (!std::isfinite(m) || m < 2) throw std::invalid_argument("superellipsoid exponent must be finite and >= 2, got " + num(m));
+  return [a, b, c, m](const Vec3& p) {
+    const double s = std::pow(std::pow(std::abs(p.x() / a), m) + std::pow(std::abs(p.y() / b), m) + std::pow(std::abs(p.z() / c), m),
+                              1.0 / m);
+    return Vec3(p / s);
+  };
+}
+
 RoughBody make_rough_mesh_body(const TriangleMesh& m, std::uint64_t n, const RadiusDistribution& radii, double density,
                                std::uint64_t seed, std::uint64_t body_id, const SurfaceMap& onto, std::string name) {
   validate(radii);

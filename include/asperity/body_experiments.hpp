@@ -73,7 +73,8 @@ std::string to_json(const RadiiReport& r);
 struct MeshImpactExperiment {
   std::filesystem::path mesh = "meshes/ellipsoid.off";
   double scale = 1.0;                  ///< mesh coordinates -> metres
-  std::vector<double> smooth_ellipsoid;  ///< empty: centres on the facets; {a, b, c}: mapped onto that ellipsoid [m]
+  std::vector<double> smooth_ellipsoid;  ///< empty: centres on the facets; {a, b, c[, m]}: mapped onto that
+                                         ///< (super)ellipsoid [m] (m = 2 if absent)
   std::uint64_t asperities = 100000;   ///< N per body
   RadiusDistribution radii = RadiusDistribution::fixed(6.5e-7);
   double density = 7850;               ///< [kg/m^3]

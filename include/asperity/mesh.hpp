@@ -43,6 +43,9 @@ MassProperties mass_properties(const TriangleMesh& m, double density);
 using SurfaceMap = std::function<Vec3(const Vec3&)>;
 /// Radial projection onto the ellipsoid (x/a)^2 + (y/b)^2 + (z/c)^2 = 1 (mesh coordinates) [m].
 SurfaceMap ellipsoid_surface(double a, double b, double c);
+/// Radial projection onto the superellipsoid |x/a|^m + |y/b|^m + |z/c|^m = 1 (m >= 2; m = 2 is
+/// the ellipsoid, meshes/rounded_cube.off is a = b = c = 2.5 mm, m = 8).
+SurfaceMap superellipsoid_surface(double a, double b, double c, double m);
 
 /// N asperity centres uniform by area on the mesh surface: triangle by area (cumulative table,
 /// binary search on one uniform), point by the sqrt trick (two uniforms), then the radius
