@@ -1,0 +1,582 @@
+#include "asperity/body_experiments.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+#include "format.hpp"
+
+#include "asperity/plot.hpp"
+#include "asperity/report.hpp"
+#include "asperity/screening.hpp"
+#include "asperity/support.hpp"
+#include "asperity/theory.hpp"
+#include "asperity/theory_radii.hpp"
+#include "asperity/orientation.hpp"
+#include "asperity/random.hpp"
+
+namespace asperity {
+namespace {
+
+using detail::num;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::vector<double> sorted_copy(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+LawCheck ks_check(const std::string& quantity, const std::vector<double>& sorted, const Law& law, double lambda,
+                  double alpha, bool power, std::string note = {}) {
+  LawCheck c;
+  c.quantity = quantity;
+  c.law = law.name;
+  c.lambda = lambda;
+  c.ks = ks_one_sample(sorted, law.cdf);
+  c.power_check = power;
+  c.verdict = c.ks.p < alpha ? "reject" : "accept";
+  c.note = std::move(note);
+  return c;
+}
+
+Curve curve_of(const Law& law, const std::string& label, double lo, double hi) {
+  Curve c;
+  c.label = label;
+  for (int i = 0; i <= 300; ++i) {
+    const double t = lo + (hi - lo) * i / 300.0;
+    const double y = law.pdf(t);
+    c.x.push_back(t);
+    c.y.push_back(std::isfinite(y) ? y : 0.0);
+  }
+  return c;
+}
+
+nlohmann::json json_of(const Estimate& e) { return {{"value", e.value}, {"se", e.se}}; }
+nlohmann::json json_of(const LawCheck& c) {
+  return {{"quantity", c.quantity}, {"law", c.law},     {"lambda", c.lambda},           {"statistic", "KS"},
+          {"D", c.ks.D},            {"p", c.ks.p},       {"n", c.ks.n},                  {"power_check", c.power_check},
+          {"verdict", c.verdict},   {"note", c.note}};
+}
+
+}  // namespace
+
+void validate(const RadiiExperiment& e) {
+  if (e.asperities < 1 || e.asperities > 0xffffffffull)
+    throw std::invalid_argument("asperities must be in [1, 2^32-1], got " + std::to_string(e.asperities));
+  if (!std::isfinite(e.radius) || e.radius <= 0)
+    throw std::invalid_argument("radius must be a finite number > 0 m, got " + num(e.radius));
+  validate(e.radii);
+  if (e.radii.kind == RadiusDistribution::Kind::lognormal && (e.screen_bodies < 1 || e.drops % e.screen_bodies != 0))
+    throw std::invalid_argument("lognormal radii: r_x comes from the screened bodies, so drops (" + std::to_string(e.drops) +
+                                ") must be a multiple of bodies (" + std::to_string(e.screen_bodies) + " >= 1)");
+  if (e.drops < 2) throw std::invalid_argument("drops must be >= 2, got " + std::to_string(e.drops));
+  if (!(e.alpha > 0 && e.alpha < 1)) throw std::invalid_argument("alpha must be in (0,1), got " + num(e.alpha));
+}
+
+namespace {
+// Lognormal radii: Gaussian laws only (no exact law), from explicit bodies; a 5%-wider Gaussian
+// with the fitted variance is the power check.
+RadiiReport finish_lognormal(const RadiiExperiment& e, RadiiReport& r, const std::vector<double>& rx,
+                             const std::vector<double>& rxy) {
+  const Summary sx = summarize_batches(rx, e.screen_bodies >= 2 ? e.screen_bodies : 1, std::vector<double>{0.5});
+  r.rx_std = sx.std;
+  r.lambda_fit = 1.0 / (2.0 * std::numbers::pi * sx.std.value * sx.std.value);
+  const auto srx = sorted_copy(rx);
+  const std::string pooled = "pooled over " + std::to_string(e.screen_bodies) + " bodies x rotations: p assumes iid";
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda, "gauss-lambda"), r.lambda, e.alpha, false, "Eq. 18, all asperities; " + pooled));
+  if (r.lambda_eff.value > 0)
+    r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_eff.value, "gauss-lambda-eff"), r.lambda_eff.value, e.alpha, false,
+                               "Eq. 18 with lambda_eff; " + pooled));
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_fit, "gauss-lambda-fit"), r.lambda_fit, e.alpha, false,
+                             "Gaussian with the sample variance (fitted: p is optimistic)"));
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_fit / (1.05 * 1.05), "gauss-lambda-fit-x1.05"), kNaN, e.alpha, true,
+                             "fitted Gaussian 5% wider: must be rejected"));
+  std::filesystem::create_directories(e.out);
+  if (e.plots && plotting_available()) {
+    const double hi = 4.5 / std::sqrt(2.0 * std::numbers::pi * r.lambda_fit);
+    HistogramFigure fig;
+    std::ostringstream t;
+    t << "r_x, N = " << e.asperities << ", radii " << e.radii.describe() << ", " << rx.size() << " drops of " << e.screen_bodies
+      << " spheres";
+    fig.title = t.str();
+    fig.xlabel = "r_x [{/Symbol m}m]";
+    fig.ylabel = "probability density [1/{/Symbol m}m]";
+    fig.x_scale = 1e6;
+    fig.y_scale = 1e-6;
+    fig.histogram = make_histogram(rx, -hi, hi, 60);
+    fig.curves.push_back(curve_of(gaussian_rx(r.lambda, "g"), "Eq. (18), {/Symbol l} of all asperities", -hi, hi));
+    if (r.lambda_eff.value > 0)
+      fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), {/Symbol l}_{eff} (screening)", -hi, hi));
+    fig.curves.push_back(curve_of(gaussian_rx(r.lambda_fit, "g"), "Gaussian, fitted variance", -hi, hi));
+    write_histogram_png(e.out / "r_x.png", fig);
+    r.plots.push_back("r_x.png");
+  }
+  (void)rxy;
+  write_file_atomic(e.out / "report.json", to_json(r));
+  write_file_atomic(e.out / "report.txt", format_table(r));
+  return r;
+}
+}  // namespace
+
+RadiiReport run_radii_experiment(const RadiiExperiment& e) {
+  validate(e);
+  RadiiReport r;
+  r.experiment = e;
+  const double R = e.radius, area = 4.0 * std::numbers::pi * R * R;
+  r.lambda = static_cast<double>(e.asperities) / area;
+  const bool lognormal = e.radii.kind == RadiusDistribution::Kind::lognormal;
+  std::vector<double> lv = e.radii.kind == RadiusDistribution::Kind::levels ? e.radii.levels
+                           : lognormal                                       ? std::vector<double>{}
+                                                                             : std::vector<double>{e.radii.radius};
+  std::vector<double> fr = e.radii.kind == RadiusDistribution::Kind::levels ? e.radii.fractions
+                           : lognormal                                       ? std::vector<double>{}
+                                                                             : std::vector<double>{1.0};
+  if (!lv.empty()) {
+    const std::size_t top = static_cast<std::size_t>(std::max_element(lv.begin(), lv.end()) - lv.begin());
+    r.lambda_top = r.lambda * fr[top];
+  } else {
+    r.lambda_top = kNaN;
+  }
+  // Lognormal radii have no exact law here: r_x then comes from M rotations of each screened body
+  // (Stream(seed, orientation, k M + j)), like the "fixed" ensemble.
+  const std::uint64_t M = lognormal ? e.drops / e.screen_bodies : 0;
+  std::vector<double> rx_explicit, rxy_explicit;
+
+  // (1) Screening of explicit bodies.
+  auto t0 = std::chrono::steady_clock::now();
+  SphereParams p;
+  p.asperities = e.asperities;
+  p.radius = R;
+  std::vector<double> lam_eff;
+  std::vector<double> kept_by(lv.size(), 0), total_by(lv.size(), 0);
+  for (std::uint64_t k = 0; k < e.screen_bodies; ++k) {
+    const RoughBody b = make_rough_sphere_body(p, e.radii, e.seed, k);
+    const auto q = make_support_tree(b.centres, b.radii);
+    const ScreeningResult s = screen_sphere(b, *q);
+    const ScreeningCheck c = check_screening(b, *q, s, e.screen_directions, e.seed + k);
+    lam_eff.push_back(s.lambda_eff);
+    if (k == 0) r.theta_cover = s.theta_cover;
+    r.mean_competitors += s.mean_competitors / static_cast<double>(e.screen_bodies);
+    r.witnessed += s.witnessed;
+    r.helly += s.helly;
+    r.screened += s.screened;
+    r.winners_screened += c.winners_screened;
+    r.kept_never_hit += c.kept_never_hit;
+    r.directions += c.directions;
+    if (lognormal) {
+      const auto m = static_cast<std::int64_t>(M);
+      const std::size_t base = rx_explicit.size();
+      rx_explicit.resize(base + M);
+      rxy_explicit.resize(base + M);
+#pragma omp parallel for schedule(static)
+      for (std::int64_t j = 0; j < m; ++j) {
+        Stream st(e.seed, Purpose::orientation, k * M + static_cast<std::uint64_t>(j));
+        const Rotation rot = random_rotation(st);
+        const BodyContact bc = make_body_contact(q->support(body_down(rot)), b, rot);
+        rx_explicit[base + static_cast<std::size_t>(j)] = bc.r.x();
+        rxy_explicit[base + static_cast<std::size_t>(j)] = std::hypot(bc.r.x(), bc.r.y());
+      }
+    }
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      const std::size_t m = static_cast<std::size_t>(std::find(lv.begin(), lv.end(), b.radii[i]) - lv.begin());
+      if (m >= lv.size()) continue;
+      total_by[m] += 1;
+      kept_by[m] += s.status[i] != Screen::screened;
+    }
+  }
+  for (std::size_t m = 0; m < lv.size(); ++m) r.kept_fraction_by_level.push_back(total_by[m] > 0 ? kept_by[m] / total_by[m] : kNaN);
+  if (!lam_eff.empty()) {
+    double m = 0, v = 0;
+    for (double x : lam_eff) m += x;
+    m /= static_cast<double>(lam_eff.size());
+    for (double x : lam_eff) v += (x - m) * (x - m);
+    r.lambda_eff.value = m;
+    r.lambda_eff.se = lam_eff.size() > 1 ? std::sqrt(v / static_cast<double>(lam_eff.size() - 1) / static_cast<double>(lam_eff.size())) : kNaN;
+  }
+  r.seconds_screen = seconds_since(t0);
+
+  if (lognormal) return finish_lognormal(e, r, rx_explicit, rxy_explicit);
+
+  // (2) Fresh drops: iid, each a pure function of (seed, drop).
+  t0 = std::chrono::steady_clock::now();
+  const auto n = static_cast<std::int64_t>(e.drops);
+  std::vector<double> rx(e.drops), rxy(e.drops);
+  std::vector<std::uint32_t> level(e.drops);
+  std::vector<std::uint8_t> core(e.drops);
+#pragma omp parallel for schedule(static)
+  for (std::int64_t k = 0; k < n; ++k) {
+    const FreshContact c = fresh_levels_contact(e.asperities, R, e.radii, e.seed, static_cast<std::uint64_t>(k));
+    const auto i = static_cast<std::size_t>(k);
+    rx[i] = c.r.x();
+    rxy[i] = std::hypot(c.r.x(), c.r.y());
+    level[i] = c.level;
+    core[i] = c.core;
+  }
+  r.seconds_fresh = seconds_since(t0);
+  r.winner_level_fraction.assign(lv.size(), 0.0);
+  // fresh_levels_contact numbers levels after dropping zero fractions; map back.
+  std::vector<std::size_t> nz;
+  for (std::size_t m = 0; m < fr.size(); ++m)
+    if (fr[m] > 0) nz.push_back(m);
+  for (std::size_t i = 0; i < level.size(); ++i) r.winner_level_fraction[nz[level[i]]] += 1.0 / static_cast<double>(e.drops);
+  for (auto c : core) r.core_contacts += c;
+  const std::vector<double> probs{0.5};
+  const Summary sx = summarize_iid(rx, probs);
+  r.rx_std = sx.std;
+  r.lambda_fit = 1.0 / (2.0 * std::numbers::pi * sx.std.value * sx.std.value);
+
+  // (3) Tests of r_x (the paper's conjecture: Gaussian -- with which lambda?).
+  const auto srx = sorted_copy(rx), srxy = sorted_copy(rxy);
+  const Law exact = levels_sphere_rx(e.asperities, R, e.radii);
+  const Law wrong = levels_sphere_rx(e.asperities, R, e.radii, 1.05);
+  const Law g_all = gaussian_rx(r.lambda, "gauss-lambda");
+  const Law g_top = gaussian_rx(r.lambda_top, "gauss-lambda-top");
+  r.tests.push_back(ks_check("r_x", srx, exact, kNaN, e.alpha, false, "exact finite-N law, level radii"));
+  r.tests.push_back(ks_check("r_x", srx, wrong, kNaN, e.alpha, true, "exact law stretched by 5%: must be rejected"));
+  r.tests.push_back(ks_check("r_x", srx, g_all, r.lambda, e.alpha, false, "Eq. 18 with all asperities"));
+  if (r.lambda_eff.value > 0)
+    r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_eff.value, "gauss-lambda-eff"), r.lambda_eff.value, e.alpha,
+                               false, "Eq. 18 with the density of asperities that can touch (screening)"));
+  r.tests.push_back(ks_check("r_x", srx, g_top, r.lambda_top, e.alpha, false, "Eq. 18 with the largest level only"));
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_fit, "gauss-lambda-fit"), r.lambda_fit, e.alpha, false,
+                             "Gaussian with the sample variance (fitted: p is optimistic)"));
+  r.tests.push_back(ks_check("r_xy", srxy, levels_sphere_rxy(e.asperities, R, e.radii), kNaN, e.alpha, false,
+                             "exact finite-N law of r_xy"));
+
+  // (4) Figures and files.
+  std::filesystem::create_directories(e.out);
+  if (e.plots && plotting_available()) {
+    const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * std::min(r.lambda_top, r.lambda_fit));
+    const double hi = 4.0 * sigma;
+    HistogramFigure fig;
+    std::ostringstream t;
+    t << "r_x, N = " << e.asperities << ", radii " << e.radii.describe() << ", " << e.drops << " fresh drops";
+    fig.title = t.str();
+    fig.xlabel = "r_x [{/Symbol m}m]";
+    fig.ylabel = "probability density [1/{/Symbol m}m]";
+    fig.x_scale = 1e6;
+    fig.y_scale = 1e-6;
+    fig.histogram = make_histogram(rx, -hi, hi, 60);
+    fig.curves.push_back(curve_of(exact, "exact law, level radii", -hi, hi));
+    fig.curves.push_back(curve_of(g_all, "Eq. (18), {/Symbol l} of all asperities", -hi, hi));
+    if (r.lambda_eff.value > 0)
+      fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), {/Symbol l}_{eff} (screening)", -hi, hi));
+    fig.curves.push_back(curve_of(g_top, "Eq. (18), {/Symbol l} of the largest level", -hi, hi));
+    write_histogram_png(e.out / "r_x.png", fig);
+    r.plots.push_back("r_x.png");
+  }
+  write_file_atomic(e.out / "report.json", to_json(r));
+  write_file_atomic(e.out / "report.txt", format_table(r));
+  return r;
+}
+
+std::string format_table(const RadiiReport& r) {
+  std::ostringstream os;
+  const auto& e = r.experiment;
+  os << "unequal asperities: N = " << e.asperities << ", R = " << e.radius << " m, radii " << e.radii.describe() << "\n";
+  os << std::setprecision(4);
+  os << "lambda = " << r.lambda << " 1/m^2, lambda_top = " << r.lambda_top << ", lambda_eff = " << r.lambda_eff.value
+     << " +- " << r.lambda_eff.se << " (" << e.screen_bodies << " screened spheres), lambda_fit = " << r.lambda_fit << "\n";
+  os << "screening: kept " << (r.witnessed + r.helly) << " (witness " << r.witnessed << ", Helly " << r.helly
+     << "), screened " << r.screened << "; kept fraction by level:";
+  for (double f : r.kept_fraction_by_level) os << " " << f;
+  os << "\n  largest empty cap " << r.theta_cover << " rad, mean competitors " << r.mean_competitors << ", "
+     << r.seconds_screen << " s\n";
+  os << "cross-check: " << r.directions << " random directions, winners screened " << r.winners_screened
+     << ", kept but never hit " << r.kept_never_hit << "\n";
+  if (e.radii.kind == RadiusDistribution::Kind::lognormal) {
+    os << "drops: " << e.drops << " (rotations of the screened spheres)";
+  } else {
+    os << "fresh drops: " << e.drops << ", touching level fractions:";
+    for (double f : r.winner_level_fraction) os << " " << f;
+  }
+  os << ", core contacts " << r.core_contacts << ", std(r_x) = " << r.rx_std.value << " +- " << r.rx_std.se << " m\n";
+  os << std::left << std::setw(6) << "qty" << std::setw(24) << "law" << std::setw(13) << "lambda" << std::setw(11) << "KS D"
+     << std::setw(11) << "p" << "verdict\n";
+  for (const auto& t : r.tests) {
+    os << std::setw(6) << t.quantity << std::setw(24) << t.law << std::setw(13) << t.lambda << std::setw(11) << t.ks.D
+       << std::setw(11) << t.ks.p << t.verdict << (t.power_check ? " (power check: must reject)" : "") << "\n";
+  }
+  return os.str();
+}
+
+std::string to_json(const RadiiReport& r) {
+  nlohmann::json j;
+  const auto& e = r.experiment;
+  j["schema_version"] = kReportSchemaVersion;
+  j["experiment"] = "unequal-radii";
+  j["asperities"] = e.asperities;
+  j["radius"] = e.radius;
+  j["radii"] = e.radii.describe();
+  j["drops"] = e.drops;
+  j["seed"] = e.seed;
+  j["alpha"] = e.alpha;
+  j["lambda"] = r.lambda;
+  j["lambda_top"] = r.lambda_top;
+  j["lambda_eff"] = json_of(r.lambda_eff);
+  j["lambda_fit"] = r.lambda_fit;
+  j["kept_fraction_by_level"] = r.kept_fraction_by_level;
+  j["screening"] = {{"bodies", e.screen_bodies},           {"witnessed", r.witnessed},
+                    {"helly", r.helly},                     {"screened", r.screened},
+                    {"theta_cover", r.theta_cover},         {"mean_competitors", r.mean_competitors},
+                    {"directions", r.directions},           {"winners_screened", r.winners_screened},
+                    {"kept_never_hit", r.kept_never_hit},   {"seconds", r.seconds_screen}};
+  j["winner_level_fraction"] = r.winner_level_fraction;
+  j["core_contacts"] = r.core_contacts;
+  j["rx_std"] = json_of(r.rx_std);
+  j["tests"] = nlohmann::json::array();
+  for (const auto& t : r.tests) j["tests"].push_back(json_of(t));
+  j["plots"] = r.plots;
+  j["seconds_fresh"] = r.seconds_fresh;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace asperity
+
+#include <Eigen/Eigenvalues>
+
+#include "asperity/body_impact.hpp"
+#include "asperity/orientation.hpp"
+#include "asperity/random.hpp"
+#include "asperity/restitution.hpp"
+#include "asperity/theory_impact.hpp"
+
+namespace asperity {
+
+void validate(const MeshImpactExperiment& e) {
+  if (!std::isfinite(e.scale) || e.scale <= 0) throw std::invalid_argument("mesh scale must be finite and > 0, got " + num(e.scale));
+  if (!e.smooth_ellipsoid.empty() && e.smooth_ellipsoid.size() != 3 && e.smooth_ellipsoid.size() != 4)
+    throw std::invalid_argument("smooth surface needs 3 semi-axes and an optional exponent, got " +
+                                std::to_string(e.smooth_ellipsoid.size()) + " numbers");
+  if (e.asperities < 1 || e.asperities > 0xffffffffull)
+    throw std::invalid_argument("asperities must be in [1, 2^32-1], got " + std::to_string(e.asperities));
+  validate(e.radii);
+  if (!std::isfinite(e.density) || e.density <= 0) throw std::invalid_argument("density must be finite and > 0, got " + num(e.density));
+  if (e.bodies < 1 || e.drops < 2 || e.drops % e.bodies != 0)
+    throw std::invalid_argument("drops (" + std::to_string(e.drops) + ") must be >= 2 and a multiple of bodies (" +
+                                std::to_string(e.bodies) + ")");
+  if (!std::isfinite(e.speed) || e.speed <= 0) throw std::invalid_argument("speed must be finite and > 0 m/s, got " + num(e.speed));
+  if (!e.omega.allFinite()) throw std::invalid_argument("omega must be finite");
+  if (!(e.alpha > 0 && e.alpha < 1)) throw std::invalid_argument("alpha must be in (0,1), got " + num(e.alpha));
+}
+
+MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
+  validate(e);
+  const auto t0 = std::chrono::steady_clock::now();
+  MeshImpactReport r;
+  r.experiment = e;
+  const TriangleMesh mesh = read_mesh(e.mesh, e.scale);
+  r.mass = mass_properties(mesh, e.density);
+  r.principal_moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.mass.inertia).eigenvalues();
+  SurfaceMap onto;
+  const double sm_m = e.smooth_ellipsoid.size() == 4 ? e.smooth_ellipsoid[3] : 2.0;
+  if (!e.smooth_ellipsoid.empty())
+    onto = superellipsoid_surface(e.smooth_ellipsoid[0], e.smooth_ellipsoid[1], e.smooth_ellipsoid[2], sm_m);
+  // Comparison sphere: equal volume (the mesh's, or the smooth ellipsoid's).
+  r.law_radius = e.smooth_ellipsoid.empty() || sm_m != 2.0
+                     ? std::cbrt(3.0 * r.mass.volume / (4.0 * std::numbers::pi))
+                     : std::cbrt(e.smooth_ellipsoid[0] * e.smooth_ellipsoid[1] * e.smooth_ellipsoid[2]);
+  const auto eps_n = viscoelastic_pade14(e.beta);
+  const std::uint64_t M = e.drops / e.bodies;
+  const std::size_t n = e.drops;
+  std::vector<double> rx(n), ry(n), rz(n), rxy(n), eps(n, kNaN), wx(n, kNaN);
+  std::vector<std::uint8_t> core(n, 0), hit(n, 0);
+  const std::string name = e.mesh.stem().string();
+  for (std::uint64_t k = 0; k < e.bodies; ++k) {
+    const RoughBody b = make_rough_mesh_body(mesh, e.asperities, e.radii, e.density, e.seed, k, onto, name);
+    if (k == 0) r.mass.area = b.area;
+    const auto q = make_support_tree(b.centres, b.radii);
+    const auto m = static_cast<std::int64_t>(M);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t j = 0; j < m; ++j) {
+      const std::uint64_t drop = k * M + static_cast<std::uint64_t>(j);
+      Stream st(e.seed, Purpose::orientation, drop);
+      const Rotation rot = random_rotation(st);
+      const BodyImpact bi = body_impact(b, *q, rot, Vec3(0, 0, -e.speed), e.omega, *eps_n, e.eps_t);
+      const Vec3& c = bi.contact.r;
+      rx[drop] = c.x(), ry[drop] = c.y(), rz[drop] = c.z(), rxy[drop] = std::hypot(c.x(), c.y());
+      // Base surface support below the centre of mass: the ellipsoid's, or the mesh's (a vertex).
+      const Vec3 d = body_down(rot);
+      double h_base = -std::numeric_limits<double>::infinity();
+      if (!e.smooth_ellipsoid.empty() && sm_m == 2.0) {
+        const double a = e.smooth_ellipsoid[0], bb = e.smooth_ellipsoid[1], cc = e.smooth_ellipsoid[2];
+        // Support of the ellipsoid (centred at the mesh origin) measured from the centre of mass.
+        h_base = std::sqrt(a * a * d.x() * d.x() + bb * bb * d.y() * d.y() + cc * cc * d.z() * d.z()) - r.mass.centroid.dot(d);
+      } else {
+        // The mesh's support is a vertex; for a smooth superellipsoid (vertices on it) a lower bound.
+        for (const Vec3& v : mesh.vertices) h_base = std::max(h_base, (v - r.mass.centroid).dot(d));
+      }
+      core[drop] = -c.z() < h_base;
+      if (bi.result) {
+        hit[drop] = 1;
+        eps[drop] = bi.result->eps;
+        wx[drop] = bi.result->Omega_after.x();
+      }
+    }
+  }
+  r.samples = n;
+  for (std::size_t i = 0; i < n; ++i) r.no_impacts += !hit[i], r.core_contacts += core[i];
+  std::vector<double> e_ok, w_ok;
+  for (std::size_t i = 0; i < n; ++i)
+    if (hit[i]) e_ok.push_back(eps[i]), w_ok.push_back(wx[i]);
+
+  const std::vector<double> probs{0.01, 0.5, 0.99};
+  const std::size_t K = e.bodies >= 2 ? e.bodies : 1;
+  auto summary = [&](const std::vector<double>& x, bool per_drop) {
+    return per_drop && K >= 2 ? summarize_batches(x, K, probs) : summarize_iid(x, probs);
+  };
+  r.quantities.push_back({"r_x", summary(rx, true)});
+  r.quantities.push_back({"r_y", summary(ry, true)});
+  r.quantities.push_back({"r_z", summary(rz, true)});
+  r.quantities.push_back({"r_xy", summary(rxy, true)});
+  if (e_ok.size() >= 2) {
+    r.quantities.push_back({"eps", summary(e_ok, e_ok.size() == n)});
+    r.quantities.push_back({"omega_x_after", summary(w_ok, w_ok.size() == n)});
+  }
+
+  // The paper's sphere laws for the comparison sphere (same areal density of asperities).
+  const double Rl = r.law_radius;
+  r.law_asperities = static_cast<std::uint64_t>(std::llround(static_cast<double>(e.asperities) * 4.0 * std::numbers::pi * Rl * Rl / r.mass.area));
+  const std::string pooled = "pooled over " + std::to_string(e.bodies) + " bodies x " + std::to_string(M) +
+                             " rotations: p assumes iid";
+  const auto srx = sorted_copy(rx);
+  const Law l18 = eq18_rx(r.law_asperities, Rl);
+  r.tests.push_back(ks_check("r_x", srx, l18, areal_density(r.law_asperities, Rl), e.alpha, false, "Eq. 18, " + pooled));
+  r.tests.push_back(ks_check("r_x", srx, eq18_rx(r.law_asperities, Rl, 1.05), kNaN, e.alpha, true, "Eq. 18 stretched by 5%: must be rejected"));
+  ImpactScene sc;
+  sc.asperities = r.law_asperities;
+  sc.radius = Rl;
+  sc.asperity_radius = e.radii.kind == RadiusDistribution::Kind::fixed ? e.radii.radius
+                       : e.radii.kind == RadiusDistribution::Kind::lognormal ? e.radii.median
+                                                                             : e.radii.levels.front();
+  sc.speed = e.speed;
+  sc.omega_x = e.omega.x();
+  sc.omega_y = e.omega.y();
+  sc.beta = e.beta;
+  const bool sec4 = e.eps_t == 1.0 && e.omega.z() == 0.0 && e_ok.size() >= 2;
+  std::vector<Law> eps_laws;
+  if (sec4) {
+    const auto se = sorted_copy(e_ok), sw = sorted_copy(w_ok);
+    eps_laws.push_back(eq28_corrected(sc));
+    r.tests.push_back(ks_check("eps", se, eps_laws.back(), kNaN, e.alpha, false, "Eq. 28 corrected, " + pooled));
+    r.tests.push_back(ks_check("eps", se, eq28_corrected(sc, 1.05), kNaN, e.alpha, true, "alpha x 1.05: must be rejected"));
+    r.tests.push_back(ks_check("omega_x_after", sw, eq33_corrected(sc), kNaN, e.alpha, false, "Eq. 33 corrected, " + pooled));
+  }
+  std::filesystem::create_directories(e.out);
+  if (e.plots && plotting_available()) {
+    std::ostringstream sub;
+    sub << name << (e.smooth_ellipsoid.empty() ? " (facets)" : " (smooth)") << ", N = " << e.asperities << ", "
+        << e.radii.describe() << ", " << e.bodies << " x " << M;
+    {
+      const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * areal_density(r.law_asperities, Rl));
+      auto v = srx;
+      double hi = std::max(4.0 * sigma, std::max(std::abs(quantile_sorted(v, 0.001)), std::abs(quantile_sorted(v, 0.999))));
+      HistogramFigure fig;
+      fig.title = "r_x: " + sub.str();
+      fig.xlabel = "r_x [{/Symbol m}m]";
+      fig.ylabel = "probability density [1/{/Symbol m}m]";
+      fig.x_scale = 1e6;
+      fig.y_scale = 1e-6;
+      fig.histogram = make_histogram(rx, -hi, hi, 80);
+      fig.curves.push_back(curve_of(l18, "Eq. (18), sphere of equal volume, same {/Symbol l}", -hi, hi));
+      write_histogram_png(e.out / "r_x.png", fig);
+      r.plots.push_back("r_x.png");
+    }
+    if (sec4) {
+      auto v = sorted_copy(e_ok);
+      double lo = quantile_sorted(v, 1e-3), hi = quantile_sorted(v, 1.0);
+      const auto par = impact_law_parameters(sc);
+      lo = std::min(lo, par.eps_max - 6 * (par.eps_max - par.eps_n + 1e-3));
+      hi = std::max(hi, par.eps_max) + 0.02 * (hi - lo);
+      HistogramFigure fig;
+      fig.title = "{/Symbol e}: " + sub.str();
+      fig.xlabel = "{/Symbol e}";
+      fig.histogram = make_histogram(e_ok, lo, hi, 80);
+      fig.curves.push_back(curve_of(eps_laws.front(), "Eq. (28) corrected, sphere of equal volume", lo, hi));
+      write_histogram_png(e.out / "eps.png", fig);
+      r.plots.push_back("eps.png");
+    }
+  }
+  r.seconds = seconds_since(t0);
+  write_file_atomic(e.out / "report.json", to_json(r));
+  write_file_atomic(e.out / "report.txt", format_table(r));
+  return r;
+}
+
+std::string format_table(const MeshImpactReport& r) {
+  std::ostringstream os;
+  const auto& e = r.experiment;
+  os << std::setprecision(4);
+  os << "mesh body " << e.mesh.string() << (e.smooth_ellipsoid.empty() ? " (centres on the facets)" : " (centres on the smooth surface)")
+     << ": N = " << e.asperities << ", radii " << e.radii.describe() << ", " << e.bodies << " bodies x "
+     << e.drops / e.bodies << " rotations\n";
+  os << "mass " << r.mass.mass << " kg, volume " << r.mass.volume << " m^3, area " << r.mass.area
+     << " m^2, principal moments " << r.principal_moments.transpose() << " kg m^2\n";
+  os << "comparison sphere: R = " << r.law_radius << " m, N = " << r.law_asperities << " (same areal density)\n";
+  os << "drops " << r.samples << ", no impact " << r.no_impacts << ", base surface lower than every asperity "
+     << r.core_contacts << "\n";
+  os << std::left << std::setw(15) << "quantity" << std::setw(24) << "mean +- se" << std::setw(13) << "std" << "q01 / q50 / q99\n";
+  for (const auto& q : r.quantities) {
+    std::ostringstream m;
+    m << std::setprecision(5) << q.summary.mean.value << " +- " << std::setprecision(2) << q.summary.mean.se;
+    os << std::setw(15) << q.name << std::setw(24) << m.str() << std::setw(13) << q.summary.std.value;
+    for (const auto& x : q.summary.quantiles) os << x.value << " ";
+    os << "\n";
+  }
+  os << std::setw(15) << "quantity" << std::setw(28) << "law" << std::setw(11) << "KS D" << std::setw(11) << "p" << "verdict\n";
+  for (const auto& t : r.tests)
+    os << std::setw(15) << t.quantity << std::setw(28) << t.law << std::setw(11) << t.ks.D << std::setw(11) << t.ks.p << t.verdict
+       << (t.power_check ? " (power check: must reject)" : "") << "\n";
+  return os.str();
+}
+
+std::string to_json(const MeshImpactReport& r) {
+  nlohmann::json j;
+  const auto& e = r.experiment;
+  j["schema_version"] = kReportSchemaVersion;
+  j["experiment"] = "mesh-impacts";
+  j["mesh"] = e.mesh.string();
+  j["smooth_ellipsoid"] = e.smooth_ellipsoid;
+  j["asperities"] = e.asperities;
+  j["radii"] = e.radii.describe();
+  j["bodies"] = e.bodies;
+  j["drops"] = e.drops;
+  j["speed"] = e.speed;
+  j["omega"] = {e.omega.x(), e.omega.y(), e.omega.z()};
+  j["seed"] = e.seed;
+  j["mass"] = {{"mass", r.mass.mass},
+               {"volume", r.mass.volume},
+               {"area", r.mass.area},
+               {"centroid", {r.mass.centroid.x(), r.mass.centroid.y(), r.mass.centroid.z()}},
+               {"principal_moments", {r.principal_moments.x(), r.principal_moments.y(), r.principal_moments.z()}}};
+  j["law_radius"] = r.law_radius;
+  j["law_asperities"] = r.law_asperities;
+  j["samples"] = r.samples;
+  j["no_impacts"] = r.no_impacts;
+  j["core_contacts"] = r.core_contacts;
+  j["quantities"] = nlohmann::json::array();
+  for (const auto& q : r.quantities)
+    j["quantities"].push_back({{"name", q.name},
+                               {"n", q.summary.n},
+                               {"mean", json_of(q.summary.mean)},
+                               {"std", json_of(q.summary.std)},
+                               {"batches", q.summary.batches}});
+  j["tests"] = nlohmann::json::array();
+  for (const auto& t : r.tests) j["tests"].push_back(json_of(t));
+  j["plots"] = r.plots;
+  j["seconds"] = r.seconds;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace asperity

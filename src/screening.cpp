@@ -1,0 +1,243 @@
+// Screening of unequal asperities on a rough sphere: exact local tests (see screening.hpp).
+#include "asperity/screening.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/convex_hull_3.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "asperity/random.hpp"
+
+namespace asperity {
+namespace {
+
+// cos of the angular radius of the largest empty spherical cap of the unit centres: the largest
+// circumcap of the facets of their convex hull (the spherical Delaunay triangulation). Returns
+// -1 (everything may compete) when the hull does not enclose the origin (tiny N).
+double cos_cover(const std::vector<Vec3>& u) {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using P = K::Point_3;
+  if (u.size() < 4) return -1.0;
+  std::vector<P> pts;
+  pts.reserve(u.size());
+  for (const Vec3& v : u) pts.emplace_back(v.x(), v.y(), v.z());
+  CGAL::Surface_mesh<P> hull;
+  CGAL::convex_hull_3(pts.begin(), pts.end(), hull);
+  if (hull.number_of_faces() < 4) return -1.0;
+  double cmin = 1.0;
+  for (auto f : hull.faces()) {
+    auto h = hull.halfedge(f);
+    const P& pa = hull.point(hull.target(h));
+    const P& pb = hull.point(hull.target(hull.next(h)));
+    const P& pc = hull.point(hull.target(hull.next(hull.next(h))));
+    const Vec3 a(pa.x(), pa.y(), pa.z()), b(pb.x(), pb.y(), pb.z()), c(pc.x(), pc.y(), pc.z());
+    const Vec3 n = (b - a).cross(c - a);
+    const double nn = n.norm();
+    if (!(nn > 0)) return -1.0;
+    const double cf = std::min({n.dot(a), n.dot(b), n.dot(c)}) / nn;
+    if (cf <= 0) return -1.0;
+    cmin = std::min(cmin, cf);
+  }
+  return cmin;
+}
+
+struct HalfSpace {
+  Vec3 n;
+  double beta;  // n.x >= beta
+};
+
+// Least-norm point of { x : n_k.x = beta_k, k in S } for |S| <= 3; false if degenerate.
+bool least_norm(const HalfSpace* const* s, int m, Vec3& x) {
+  if (m == 0) {
+    x.setZero();
+    return true;
+  }
+  if (m == 1) {
+    const double nn = s[0]->n.squaredNorm();
+    if (!(nn > 0)) return false;
+    x = (s[0]->beta / nn) * s[0]->n;
+    return true;
+  }
+  if (m == 2) {
+    const Vec3 &a = s[0]->n, &b = s[1]->n;
+    const double g00 = a.dot(a), g01 = a.dot(b), g11 = b.dot(b);
+    const double det = g00 * g11 - g01 * g01;
+    if (!(det > 1e-13 * g00 * g11)) return false;
+    const double l0 = (g11 * s[0]->beta - g01 * s[1]->beta) / det;
+    const double l1 = (g00 * s[1]->beta - g01 * s[0]->beta) / det;
+    x = l0 * a + l1 * b;
+    return true;
+  }
+  const Vec3 &a = s[0]->n, &b = s[1]->n, &c = s[2]->n;
+  const Vec3 bc = b.cross(c), ca = c.cross(a), ab = a.cross(b);
+  const double det = a.dot(bc);
+  if (!(std::abs(det) > 1e-12 * a.norm() * b.norm() * c.norm())) return false;
+  x = (s[0]->beta * bc + s[1]->beta * ca + s[2]->beta * ab) / det;
+  return true;
+}
+
+// Does the intersection of the unit ball with the given half-spaces (at most 4) have a point?
+// Its min-norm point is the least-norm point of some subset of <= 3 active constraints (KKT),
+// so the smallest feasible candidate norm is the exact minimum. Tolerances favour "yes".
+bool ball_meets(const HalfSpace* hs, int m) {
+  const HalfSpace* sub[3];
+  double best = std::numeric_limits<double>::infinity();
+  for (int mask = 0; mask < (1 << m); ++mask) {
+    const int bits = __builtin_popcount(static_cast<unsigned>(mask));
+    if (bits > 3) continue;
+    int k = 0;
+    for (int i = 0; i < m; ++i)
+      if (mask & (1 << i)) sub[k++] = &hs[i];
+    Vec3 x;
+    if (!least_norm(sub, bits, x)) continue;
+    bool ok = true;
+    for (int i = 0; i < m && ok; ++i) ok = hs[i].n.dot(x) >= hs[i].beta - 1e-12 * (hs[i].n.norm() + std::abs(hs[i].beta));
+    if (ok) best = std::min(best, x.squaredNorm());
+  }
+  return best <= 1.0 + 1e-10;
+}
+
+}  // namespace
+
+ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double R = b.base_radius;
+  if (!(R > 0)) throw std::invalid_argument("screen_sphere: body '" + b.name + "' is not a rough sphere (base radius 0)");
+  const std::size_t n = b.size();
+  std::vector<Vec3> u(n);
+  std::vector<double> s(n);
+  double s_min = std::numeric_limits<double>::infinity(), s_max = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    u[i] = b.centres[i] / R;
+    s[i] = b.radii[i] / R;
+    s_min = std::min(s_min, s[i]);
+    s_max = std::max(s_max, s[i]);
+  }
+  const double ccov = cos_cover(u);
+  // Padded: the region bound must never be too small.
+  const double delta_cov = (1.0 - ccov) * (1 + 1e-9) + 1e-15;
+
+  ScreeningResult r;
+  r.status.assign(n, Screen::helly);
+  r.area = 4.0 * std::numbers::pi * R * R;
+  r.lambda = static_cast<double>(n) / r.area;
+  r.theta_cover = std::acos(std::max(-1.0, ccov));
+  std::vector<std::uint32_t> ncomp(n, 0);
+
+  const auto N = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (std::int64_t jj = 0; jj < N; ++jj) {
+    const auto j = static_cast<std::uint32_t>(jj);
+    const Vec3& uj = u[j];
+    // j can only win at d with 1 - u_j.d <= delta_cov + s_j - s_min (the nearest centre to d is
+    // within the largest empty cap, and it has s >= s_min).
+    const double delta = (delta_cov + (s[j] - s_min)) * (1 + 1e-9) + 1e-15;
+    const double c = 1.0 - delta;
+    const double S = c > 0 ? std::sqrt(std::max(0.0, 1.0 - c * c)) : 1.0;
+    const double bmax = s_max - s[j];
+    double L = c > 0 ? (S + std::sqrt(S * S + 2.0 * c * bmax)) / c : 2.1;
+    L = std::min(2.1, L * (1 + 1e-9) + 1e-12);
+    std::vector<HalfSpace> comp;
+    for (std::uint32_t i : q.within(b.centres[j], L * R)) {
+      if (i == j) continue;
+      const Vec3 a = uj - u[i];
+      const double beta = s[i] - s[j];
+      if (c > 0) {
+        // min over the cap region {|x| <= 1, u_j.x >= c} of a.x, on its rim.
+        const double au = a.dot(uj);
+        const double perp = std::sqrt(std::max(0.0, a.squaredNorm() - au * au));
+        if (c * au - S * perp - beta > 1e-13) continue;  // satisfied everywhere in the region
+      }
+      comp.push_back({a, beta});
+    }
+    ncomp[j] = static_cast<std::uint32_t>(comp.size());
+    // Most threatening (most violated at d = u_j) first: certificates of screening come early.
+    std::sort(comp.begin(), comp.end(), [&](const HalfSpace& x, const HalfSpace& y) {
+      return x.beta - x.n.dot(uj) > y.beta - y.n.dot(uj);
+    });
+
+    // Witness search: over-relaxed projections onto the most violated constraint, on the sphere.
+    Vec3 d = uj;
+    bool won = false;
+    for (int it = 0; it < 200; ++it) {
+      double worst = 0;
+      const HalfSpace* w = nullptr;
+      for (const HalfSpace& h : comp) {
+        const double v = h.n.dot(d) - h.beta;
+        if (v < worst) worst = v, w = &h;
+      }
+      if (!w) {
+        const Support sp = q.support(d);
+        won = support_value(b.centres[j], b.radii[j], d) >= sp.h;
+        break;
+      }
+      d += 1.5 * (-worst / w->n.squaredNorm()) * w->n;
+      d.normalize();
+      if (d.dot(uj) < c) break;  // left the region where j can win
+    }
+    if (won) {
+      r.status[j] = Screen::witness;
+      continue;
+    }
+    // Helly: the unit ball, the region half-space and every triple of competitors.
+    HalfSpace hs[4];
+    hs[0] = {uj, c};
+    const int k = static_cast<int>(comp.size());
+    bool screened = false;
+    if (k < 3) {
+      for (int i = 0; i < k; ++i) hs[1 + i] = comp[static_cast<std::size_t>(i)];
+      screened = !ball_meets(hs, 1 + k);
+    } else {
+      for (int z = 2; z < k && !screened; ++z)
+        for (int y = 1; y < z && !screened; ++y)
+          for (int x = 0; x < y && !screened; ++x) {
+            hs[1] = comp[static_cast<std::size_t>(x)];
+            hs[2] = comp[static_cast<std::size_t>(y)];
+            hs[3] = comp[static_cast<std::size_t>(z)];
+            screened = !ball_meets(hs, 4);
+          }
+    }
+    if (screened) r.status[j] = Screen::screened;
+  }
+  double comp_sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    comp_sum += ncomp[i];
+    switch (r.status[i]) {
+      case Screen::screened: ++r.screened; break;
+      case Screen::witness: ++r.witnessed; break;
+      case Screen::helly: ++r.helly; break;
+    }
+  }
+  r.kept = r.witnessed + r.helly;
+  r.lambda_eff = static_cast<double>(r.kept) / r.area;
+  r.mean_competitors = n ? comp_sum / static_cast<double>(n) : 0.0;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+ScreeningCheck check_screening(const RoughBody& b, const SupportQuery& q, const ScreeningResult& r,
+                               std::uint64_t directions, std::uint64_t seed) {
+  ScreeningCheck c;
+  c.directions = directions;
+  std::vector<std::uint8_t> hit(b.size(), 0);
+  for (std::uint64_t k = 0; k < directions; ++k) {
+    Stream st(seed, Purpose::analysis, k);
+    const double u = st.uniform0(), v = st.uniform0();
+    const Support s = q.support(uniform_on_sphere(u, v));
+    hit[s.index] = 1;
+  }
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const bool kept = r.status[i] != Screen::screened;
+    if (hit[i]) ++c.distinct_winners;
+    if (hit[i] && !kept) ++c.winners_screened;
+    if (!hit[i] && kept) ++c.kept_never_hit;
+  }
+  return c;
+}
+
+}  // namespace asperity
