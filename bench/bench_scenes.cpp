@@ -8,6 +8,7 @@
 // time (run_contact_ensemble: generation + index + queries) with a brute scan and with the grid,
 // for several M. The crossing point is what backend "auto" uses (plan.hpp kScanBelowRotations).
 //
+// --scan-only: part 2 only.
 // --quick: seconds-long smoke run on tiny scenes (checks the harness, never a timing).
 #include <algorithm>
 #include <chrono>
@@ -119,34 +120,8 @@ void scan_or_index(std::uint64_t n, std::uint64_t spheres, const std::vector<std
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  bool quick = false;
-  int repeats = 5;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--quick") {
-      quick = true;
-    } else if (a == "--repeats" && i + 1 < argc) {
-      repeats = std::atoi(argv[++i]);
-      if (repeats < 1) {
-        std::cerr << "bench_scenes: --repeats must be >= 1\n";
-        return 2;
-      }
-    } else {
-      std::cerr << "usage: bench_scenes [--quick] [--repeats R]\n";
-      return 2;
-    }
-  }
-  if (quick) repeats = 1;
-  const auto start = Clock::now();
-  const std::time_t now = std::time(nullptr);
-  char when[64];
-  std::strftime(when, sizeof when, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-  std::cout << "bench_scenes " << (quick ? "--quick " : "") << "started " << when << ", load average " << loadavg()
-            << "\n";
-
+// Part 1: the same scene with different outputs / backend choices.
+void whole_runs(bool quick, int repeats) {
   // fig4 with three choices of outputs.
   Scene fig4 = preset("fig4");
   fig4.plots = false;
@@ -171,7 +146,39 @@ int main(int argc, char** argv) {
   savings("fig3-fixed with " + std::to_string(fixed.ensemble.spheres) + " spheres x 1 rotation (N = " +
               std::to_string(fixed.ensemble.sphere.asperities) + ")",
           {{"backend = \"grid\" (preset)", fixed}, {"backend = \"auto\" (scan)", fixed_auto}}, repeats);
+}
 
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool quick = false, scan_only = false;
+  int repeats = 5;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--quick") {
+      quick = true;
+    } else if (a == "--scan-only") {
+      scan_only = true;
+    } else if (a == "--repeats" && i + 1 < argc) {
+      repeats = std::atoi(argv[++i]);
+      if (repeats < 1) {
+        std::cerr << "bench_scenes: --repeats must be >= 1\n";
+        return 2;
+      }
+    } else {
+      std::cerr << "usage: bench_scenes [--quick] [--scan-only] [--repeats R]\n";
+      return 2;
+    }
+  }
+  if (quick) repeats = 1;
+  const auto start = Clock::now();
+  const std::time_t now = std::time(nullptr);
+  char when[64];
+  std::strftime(when, sizeof when, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+  std::cout << "bench_scenes " << (quick ? "--quick " : "") << "started " << when << ", load average " << loadavg()
+            << "\n";
+
+  if (!scan_only) whole_runs(quick, repeats);
   if (quick) {
     scan_or_index(2000, 8, {1, 64}, 1);
   } else {

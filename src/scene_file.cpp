@@ -456,8 +456,9 @@ std::string to_toml(const Scene& s) {
      << "\nrestitution = { model = \"viscoelastic\", beta = " << num(x.beta) << " }\n\n";
   os << "[asperities]\ncount = " << e.sphere.asperities << "\nradius = { distribution = \"fixed\", value = "
      << num(e.sphere.asperity_radius) << " }\n\n";
-  os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\nspheres = " << e.spheres
-     << "\nseed = ";
+  os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\n";
+  if (e.mode == Mode::fixed) os << "spheres = " << e.spheres << "\n";  // fresh mode has no explicit spheres
+  os << "seed = ";
   if (e.seed > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
     os << quote(std::to_string(e.seed));
   else

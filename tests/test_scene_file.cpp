@@ -131,6 +131,10 @@ TEST(SceneFile, RoundTripsThroughToToml) {
   Scene contact_only = preset("fig3");
   contact_only.restitution_stats = false;
   scenes.push_back(contact_only);
+  // Unused settings are not written: they read back as defaults.
+  Scene fresh_with_spheres = preset("fig3");
+  fresh_with_spheres.ensemble.spheres = 100;  // e.g. fig3-fixed --mode fresh
+  EXPECT_EQ(parse_scene(to_toml(fresh_with_spheres)).ensemble.spheres, 1u);
   for (const auto& s : scenes) {
     const std::string text = to_toml(s);
     Scene back;

@@ -35,8 +35,9 @@ Scene parse_scene(std::string_view toml_text, std::string_view origin = "scene")
 /// Reads and parses a scene file; throws SceneError (also for an unreadable file).
 Scene load_scene(const std::filesystem::path& file);
 
-/// The scene as a format-1 TOML document with every key written: parse_scene(to_toml(s)) == s for
-/// every valid scene (impact settings of a contact experiment are not written: they are unused).
+/// The scene as a format-1 TOML document with every key it uses written: parse_scene(to_toml(s))
+/// == s for every valid scene. Settings a scene does not use are not written and read back as
+/// their defaults: V and Omega of a contact experiment, spheres in fresh mode.
 std::string to_toml(const Scene& s);
 
 }  // namespace asperity
