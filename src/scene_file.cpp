@@ -420,9 +420,81 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   return s;
 }
 
+// toml++ 3.3 (Debian 12) violates its own precondition on a table header whose name does not
+// start with a key character ("[\n", "[[=", "[[[1]]"): an assertion failure in debug builds,
+// undefined behaviour (__builtin_assume) in clang release builds (upstream marzer/tomlplusplus
+// PR #301). Such headers are never valid TOML, so they are refused here, before toml++ sees them.
+// Returns the 1-based line of the first one, 0 if there is none. Tracks strings, comments and
+// multi-line arrays so that a '[' inside a value is not taken for a header.
+std::size_t bad_table_header(std::string_view t) {
+  std::size_t line = 1;
+  bool line_start = true, in_header = false;
+  int depth = 0;  // nesting of [ and { inside a value
+  const std::size_t n = t.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = t[i];
+    if (c == '\n') {
+      ++line;
+      in_header = false;
+      if (depth == 0) line_start = true;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') continue;
+    if (c == '#') {
+      while (i + 1 < n && t[i + 1] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      line_start = false;
+      if (i + 2 < n && t[i + 1] == c && t[i + 2] == c) {  // multi-line string
+        const std::string_view close = c == '"' ? std::string_view("\"\"\"") : std::string_view("'''");
+        i += 3;
+        while (i < n && t.substr(i, 3) != close) {
+          if (c == '"' && t[i] == '\\' && i + 1 < n) ++i;  // an escape (maybe a line-ending backslash)
+          if (t[i] == '\n') ++line;
+          ++i;
+        }
+        i += 2;  // at the last quote of the closing triple (the loop's ++i steps past it)
+      } else {
+        ++i;
+        while (i < n && t[i] != c && t[i] != '\n') {
+          if (c == '"' && t[i] == '\\') ++i;
+          ++i;
+        }
+        if (i < n && t[i] == '\n') --i;  // unterminated: let the newline be counted
+      }
+      continue;
+    }
+    if (line_start && depth == 0 && c == '[') {
+      std::size_t j = i + 1;
+      if (j < n && t[j] == '[') ++j;
+      while (j < n && (t[j] == ' ' || t[j] == '\t')) ++j;
+      if (j < n) {
+        const char k = t[j];
+        const bool key_start = (k >= 'A' && k <= 'Z') || (k >= 'a' && k <= 'z') || (k >= '0' && k <= '9') ||
+                               k == '_' || k == '-' || k == '"' || k == '\'';
+        if (!key_start) return line;
+      }
+      in_header = true;
+      line_start = false;
+      i = j - 1;
+      continue;
+    }
+    line_start = false;
+    if (in_header) continue;
+    if (c == '[' || c == '{') ++depth;
+    else if ((c == ']' || c == '}') && depth > 0) --depth;
+  }
+  return 0;
+}
+
 }  // namespace
 
 Scene parse_scene(std::string_view toml_text, std::string_view origin) {
+  if (const std::size_t line = bad_table_header(toml_text))
+    throw SceneError(std::string(origin) + ":" + std::to_string(line) +
+                         ": TOML syntax error: a table header must start with a key, e.g. [body]",
+                     "");
   toml::table root;
   try {
     root = toml::parse(toml_text, std::string(origin));

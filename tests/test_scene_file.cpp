@@ -263,6 +263,20 @@ TEST(SceneFile, SyntaxErrorsAndUnreadableFilesAreSceneErrors) {
   } catch (const SceneError& e) {
     EXPECT_NE(std::string(e.what()).find("broken.toml:2"), std::string::npos) << e.what();
   }
+  // Table headers that trip an assertion inside toml++ 3.3 (upstream PR #301) are refused first.
+  for (const char* text : {"[\n", "format = 1\n[\t\nx = 1\n", "[[\n", "[[=", "[[[1]]]\n", "[[[]]\n", "  [ ]\n"}) {
+    try {
+      parse_scene(text, "hdr.toml");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find("hdr.toml:"), std::string::npos) << e.what();
+    }
+  }
+  // ... while brackets inside values, strings and comments are not headers.
+  EXPECT_EQ(parse_scene("format = 1\nname = \"\"\"a\n[\n\"\"\"\n# [\n[experiment]\nkind = \"impact\"\n"
+                        "V = [\n0.0,\n0.0,\n-1.0,\n]\nOmega = [0, 0, 0]\n")
+                .name,
+            "a\n[\n");
   EXPECT_THROW(parse_scene(std::string("format = 1\nname = \"a\xff\"\n")), SceneError);  // not UTF-8
   EXPECT_THROW(parse_scene("format = 1\nformat = 1\n"), SceneError);                  // duplicate key
   EXPECT_THROW(load_scene("/nonexistent/scene.toml"), SceneError);
