@@ -77,14 +77,19 @@ ImpactScene impact_scene(const EnsembleConfig& e) {
   return x;
 }
 
-std::vector<LawSet> laws_for(const EnsembleConfig& e) {
+// The laws of the requested outputs only: contact laws if `contact`, impact laws if the
+// experiment has impacts (the planner turns impacts off when restitution is not requested).
+std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact) {
   const auto& p = e.sphere;
   const double R = p.radius;
   const auto n = p.asperities;
-  const Law rx = exact_sphere_rx(n, R);  // tabulated once, shared by r_x and r_y
-  std::vector<LawSet> sets{{"r_xy", {eq14_rxy(n, R), exact_sphere_rxy(n, R)}, {true, true}, {false, false}},
-                           {"r_x", {eq18_rx(n, R), rx}, {true, true}, {false, false}},
-                           {"r_y", {eq18_rx(n, R), rx}, {true, true}, {false, false}}};
+  std::vector<LawSet> sets;
+  if (contact) {
+    const Law rx = exact_sphere_rx(n, R);  // tabulated once, shared by r_x and r_y
+    sets = {{"r_xy", {eq14_rxy(n, R), exact_sphere_rxy(n, R)}, {true, true}, {false, false}},
+            {"r_x", {eq18_rx(n, R), rx}, {true, true}, {false, false}},
+            {"r_y", {eq18_rx(n, R), rx}, {true, true}, {false, false}}};
+  }
   // The Sec. IV laws assume eps_t = 1 and a horizontal spin.
   if (e.impact.enabled && e.impact.eps_t == 1.0 && e.impact.omega.z() == 0.0) {
     ImpactScene x = impact_scene(e);
@@ -164,7 +169,8 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
         "drops are iid. Only the asperities that can touch are generated (exact order statistics).";
   }
 
-  std::vector<std::string> names{"r_xy", "r_x", "r_y", "r_z"};
+  std::vector<std::string> names;
+  if (scene.contact_stats) names = {"r_xy", "r_x", "r_y", "r_z"};
   // Impact quantities are batched by sphere only when every drop impacted (no drop missing).
   const bool impact = scene.ensemble.impact.enabled && s.eps.size() >= 2;
   if (impact) names.insert(names.end(), {"eps", "omega_x_after"});
@@ -186,7 +192,7 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
   }
   r.no_impacts = s.no_impacts;
 
-  for (const auto& set : laws_for(scene.ensemble)) {
+  for (const auto& set : laws_for(scene.ensemble, scene.contact_stats)) {
     const auto& x = column(s, set.quantity);
     if (x.empty()) continue;
     const bool all_drops = x.size() == n;
@@ -239,7 +245,7 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
     }
   }
 
-  {
+  if (scene.contact_stats) {
     // Core contacts: binomial(drops, P_core) for fresh spheres; two-sided exact p-value.
     TestReport t{"core_contacts", "exact-sphere", fixed ? "pooled" : "all", "binomial", kNaN, 1, n,
                  r.core_probability * double(n), !fixed, !fixed, "", ""};
@@ -370,6 +376,14 @@ std::string to_json(const GeometryReport& r) {
   j["timings_s"] = tm;
   if (r.index_bytes) j["index_bytes_per_asperity"] = double(r.index_bytes) / double(e.sphere.asperities);
   j["plots"] = r.plots;
+  if (!r.plan.empty()) {
+    json plan = json::array();
+    for (const auto& st : r.plan)
+      plan.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
+                      {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
+    j["plan"] = plan;
+  }
+  if (!r.scene_toml.empty()) j["scene_file"] = r.scene_toml;
   return j.dump(2) + "\n";
 }
 
@@ -402,7 +416,7 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
   std::ostringstream sub;
   sub << "N = " << sp.asperities << ", {/Symbol r} = " << sp.asperity_radius << " m, " << to_string(scene.ensemble.mode)
       << ", n = " << s.r_xy.size();
-  for (const auto& set : laws_for(scene.ensemble)) {
+  for (const auto& set : laws_for(scene.ensemble, scene.contact_stats)) {
     const auto& x = column(s, set.quantity);
     if (x.empty()) continue;
     HistogramFigure fig;

@@ -3,48 +3,27 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "asperity/scene_file.hpp"
+#include "asperity_embedded_scenes.hpp"  // generated from scenes/*.toml (CMakeLists.txt)
+
 namespace asperity {
 
-std::vector<std::string> preset_names() { return {"fig3", "fig3-fixed", "fig4", "fig5"}; }
+std::vector<std::string> preset_names() {
+  std::vector<std::string> names;
+  for (const auto& s : embedded::kScenes) names.emplace_back(s.name);
+  return names;
+}
 
-Scene preset(std::string_view name) {
-  Scene s;
-  s.ensemble.sphere = SphereParams{100000, 3e-3, 6.5e-7};
-  s.ensemble.drops = 1000000;
-  s.ensemble.seed = 1;
-  if (name == "fig3") {
-    s.name = "fig3";
-    s.ensemble.mode = Mode::fresh;
-    return s;
-  }
-  if (name == "fig3-fixed") {
-    // The same physics from explicit spheres: 100 spheres x 10^4 rotations.
-    s.name = "fig3-fixed";
-    s.ensemble.mode = Mode::fixed;
-    s.ensemble.spheres = 100;
-    s.ensemble.backend = Backend::grid;
-    return s;
-  }
-  if (name == "fig4") {
-    // Fig. 4: eps from explicit geometry + the full impulse; V.n = 1.3 m/s, Omega_x = 0.2 rad/s.
-    s.name = "fig4";
-    s.ensemble.impact.enabled = true;
-    s.ensemble.impact.speed = 1.3;
-    s.ensemble.impact.omega = Vec3(0.2, 0.0, 0.0);
-    return s;
-  }
-  if (name == "fig5") {
-    // Fig. 5: Omega'_x with Omega = 0, V.n = 1 m/s, a = R x 1e-4.
-    s.name = "fig5";
-    s.ensemble.sphere.asperity_radius = 3e-3 * 1e-4;
-    s.ensemble.impact.enabled = true;
-    s.ensemble.impact.speed = 1.0;
-    s.ensemble.impact.omega = Vec3(0.0, 0.0, 0.0);
-    return s;
-  }
+std::string_view preset_text(std::string_view name) {
+  for (const auto& s : embedded::kScenes)
+    if (s.name == name) return s.text;
   std::string known;
   for (const auto& p : preset_names()) known += (known.empty() ? "" : ", ") + p;
   throw std::invalid_argument("unknown preset '" + std::string(name) + "' (known: " + known + ")");
+}
+
+Scene preset(std::string_view name) {
+  return parse_scene(preset_text(name), "preset " + std::string(name) + " (scenes/" + std::string(name) + ".toml)");
 }
 
 void validate(const Scene& s) {
@@ -52,6 +31,9 @@ void validate(const Scene& s) {
   if (!(s.alpha > 0 && s.alpha < 1))
     throw std::invalid_argument("alpha must be in (0, 1), got " + std::to_string(s.alpha));
   if (s.out.empty()) throw std::invalid_argument("out must not be empty");
+  if (s.report.empty() || s.report.find('/') != std::string::npos || s.report == "." || s.report == "..")
+    throw std::invalid_argument("report must be a file name inside out, got '" + s.report + "'");
+  if (s.name.empty()) throw std::invalid_argument("name must not be empty");
 }
 
 }  // namespace asperity

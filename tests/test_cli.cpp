@@ -126,4 +126,93 @@ TEST(Cli, FiguresAreWrittenWhenAsked) {
   fs::remove_all(out);
 }
 
+// --scene: a scene file runs like a preset, its errors name the key, the report lists the plan.
+fs::path write_scene(const std::string& name, const std::string& text) {
+  const fs::path f = fs::temp_directory_path() / ("asperity-cli-" + std::to_string(::getpid()) + "-" + name + ".toml");
+  std::ofstream(f) << text;
+  return f;
+}
+
+nlohmann::json read_report(const fs::path& file) {
+  std::ifstream f(file);
+  return nlohmann::json::parse(f);
+}
+
+TEST(CliScene, ATinySceneWritesAReportWithItsPlan) {
+  const fs::path out = fresh_dir("scene");
+  const fs::path scene = write_scene("tiny", "format = 1\nname = \"tiny\"\n[asperities]\ncount = 500\n"
+                                             "[ensemble]\ndrops = 3000\n[outputs]\nplots = false\n"
+                                             "report = \"tiny.json\"\ndir = \"" + out.string() + "\"\n");
+  const CliRun r = run("--scene " + scene.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("scene tiny"), std::string::npos) << r.out;
+  const auto j = read_report(out / "tiny.json");
+  EXPECT_EQ(j.at("scene"), "tiny");
+  EXPECT_EQ(j.at("samples"), 3000);
+  EXPECT_EQ(j.at("parameters").at("asperities"), 500);
+  std::set<std::string> run_stages, skipped;
+  for (const auto& st : j.at("plan")) {
+    EXPECT_FALSE(st.at("reason").get<std::string>().empty());
+    (st.at("run").get<bool>() ? run_stages : skipped).insert(st.at("stage").get<std::string>());
+    if (st.at("run").get<bool>()) EXPECT_GE(st.at("seconds").get<double>(), 0.0);
+    else EXPECT_TRUE(st.at("seconds").is_null());
+  }
+  EXPECT_EQ(run_stages, (std::set<std::string>{"query", "analysis"}));
+  EXPECT_EQ(skipped, (std::set<std::string>{"generate", "index", "impact", "plots"}));
+  for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
+  EXPECT_NE(j.at("scene_file").get<std::string>().find("count = 500"), std::string::npos);
+  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().filename(), "tiny.json");
+  fs::remove_all(out);
+  fs::remove(scene);
+}
+
+TEST(CliScene, PresetIsTheSameRunAsItsSceneFile) {
+  for (const std::string name : {"fig3", "fig3-fixed", "fig4"}) {
+    // The same output directory for both (it is echoed in the report's scene_file).
+    const fs::path out = fresh_dir("preset-vs-file");
+    const std::string common = " --asperities 500 --drops 2000 --no-plots --out " + out.string();
+    const CliRun ra = run("--preset " + name + common);
+    auto ja = read_report(out / "report.json");
+    fs::remove_all(out);
+    const CliRun rb = run("--scene " + std::string(SCENES_DIR) + "/" + name + ".toml" + common);
+    auto jb = read_report(out / "report.json");
+    fs::remove_all(out);
+    ASSERT_EQ(ra.status, rb.status) << ra.out << rb.out;
+    for (auto* j : {&ja, &jb}) {
+      j->erase("timings_s");
+      for (auto& st : j->at("plan")) st.erase("seconds");
+    }
+    EXPECT_TRUE(ja == jb) << name << ": " << nlohmann::json::diff(ja, jb).dump();
+  }
+}
+
+TEST(CliScene, BadScenesExitWith2NamingTheKeyAndWriteNothing) {
+  const std::vector<Bad> cases = {
+      {"format = 1\n[body]\nradius = nan\n", "body.radius"},
+      {"format = 1\n[ensemble]\ndrops = -3\n", "ensemble.drops"},
+      {"format = 1\n[outputs]\ncolour = 1\n", "outputs.colour"},
+      {"format = 1\n[experiment]\nkind = \"bounce\"\n", "not supported yet: experiment.kind"},
+      {"format = 1\n[asperities]\nradius = { distribution = \"lognormal\", median = 1e-7, sigma = 0.1 }\n",
+       "not supported yet: asperities.radius.distribution"},
+      {"format = 1\nname = \"\"\n", "name"},
+      {"[body\n", "TOML syntax error"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = fresh_dir("badscene");
+    const fs::path scene = write_scene("bad", c.args);
+    const CliRun r = run("--scene " + scene.string() + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.must_mention), std::string::npos) << c.args << " did not name " << c.must_mention << ":\n" << r.out;
+    EXPECT_NE(r.out.find(scene.string()), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+    fs::remove_all(out);
+    fs::remove(scene);
+  }
+  const CliRun missing = run("--scene /nonexistent/x.toml");
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_NE(missing.out.find("/nonexistent/x.toml"), std::string::npos) << missing.out;
+  const CliRun both = run("--scene x.toml --preset fig3");
+  EXPECT_EQ(both.status, 2) << both.out;
+}
+
 }  // namespace

@@ -31,6 +31,8 @@ struct ImpactExperiment {
   double density = 7850;         ///< [kg/m^3]; mass M = 4/3 pi R^3 density (eps does not depend on it)
   double beta = 0.0467;          ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
   double eps_t = 1.0;            ///< tangential restitution (paper: 1)
+
+  friend bool operator==(const ImpactExperiment&, const ImpactExperiment&) = default;
 };
 
 struct EnsembleConfig {
@@ -42,6 +44,8 @@ struct EnsembleConfig {
   Backend backend = Backend::grid;  ///< fixed mode only
   int threads = 0;                  ///< 0 = OpenMP default
   ImpactExperiment impact;          ///< off: contact statistics only (nothing else is computed)
+
+  friend bool operator==(const EnsembleConfig&, const EnsembleConfig&) = default;
 };
 
 /// Throws std::invalid_argument naming the offending field.

@@ -21,6 +21,8 @@ struct SphereParams {
   std::uint64_t asperities = 100000;  ///< N >= 1
   double radius = 3e-3;               ///< R (varrho), central sphere radius [m]
   double asperity_radius = 6.5e-7;    ///< a (rho), asperity radius [m], 0 < a < R
+
+  friend bool operator==(const SphereParams&, const SphereParams&) = default;
 };
 
 /// Throws std::invalid_argument naming the offending field and value if the parameters are not

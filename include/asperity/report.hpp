@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "asperity/ensemble.hpp"
+#include "asperity/plan.hpp"
 #include "asperity/scene.hpp"
 #include "asperity/statistics.hpp"
 
@@ -53,12 +54,16 @@ struct GeometryReport {
   std::uint64_t no_impacts = 0;       ///< contacts that did not approach the plate
   double eps_n_mean = 0;              ///< mean microscopic eps_n
   Estimate eps_deficit;               ///< eps_n - <eps> with its standard error
+  // Filled by run_scene (run.hpp):
+  std::vector<PlanStage> plan;        ///< every stage, run or skipped with its reason, and its time
+  std::string scene_toml;             ///< the scene that ran, as a scene file (to_toml)
 
   /// A decisive test rejected its law.
   bool rejected() const;
 };
 
-/// Summaries and tests of a run. Sorts copies of the samples; O(n log n).
+/// Summaries and tests of a run: the contact laws only if scene.contact_stats, the restitution laws
+/// only if the samples hold impacts. Sorts copies of the samples; O(n log n).
 GeometryReport analyse(const Scene& scene, const ContactSamples& s);
 
 /// The human-readable table (quantity | measured +- se | law | KS D | p | verdict).

@@ -15,7 +15,9 @@
 
 #include "asperity/plot.hpp"
 #include "asperity/report.hpp"
+#include "asperity/run.hpp"
 #include "asperity/scene.hpp"
+#include "asperity/scene_file.hpp"
 
 namespace fs = std::filesystem;
 using namespace asperity;
@@ -108,7 +110,10 @@ int main(int argc, char** argv) {
   int threads = 0;
   double alpha = 0.01;
   bool no_plots = false, quiet = false;
-  app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5");
+  std::string scene_file;
+  auto* preset_opt = app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5");
+  app.add_option("--scene", scene_file, "scene file (TOML, see README \"Scenes\"); the options below override it")
+      ->excludes(preset_opt);
   app.add_option("--asperities,-N", asperities, "number of asperities N (>= 1)");
   app.add_option("--radius", radius, "central sphere radius R [m]");
   app.add_option("--asperity-radius", asperity_radius, "asperity radius a [m], 0 < a < R");
@@ -139,7 +144,7 @@ int main(int argc, char** argv) {
   try {
     // Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
     auto given = [&](const char* name) { return app.count(name) > 0; };
-    scene = preset(preset_name);
+    scene = given("--scene") ? load_scene(scene_file) : preset(preset_name);
     auto& e = scene.ensemble;
     if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities);
     if (given("--radius")) e.sphere.radius = parse_positive("--radius", radius);
@@ -158,24 +163,28 @@ int main(int argc, char** argv) {
     if (given("--mode")) e.mode = parse_mode(mode);
     if (given("--speed")) {
       e.impact.enabled = true;
+      scene.restitution_stats = true;
       e.impact.speed = parse_positive("--speed", speed, "m/s");
     }
     if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", omega_x);
     if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", omega_y);
     if ((given("--omega-x") || given("--omega-y")) && !e.impact.enabled)
       throw BadInput("--omega-x/--omega-y need an impact: give --speed or a preset with impacts (fig4, fig5)");
-    if (given("--backend")) e.backend = parse_backend(backend);
+    if (given("--backend")) {
+      e.backend = parse_backend(backend);
+      scene.backend_auto = false;
+    }
     if (threads < 0) throw BadInput("--threads: '" + std::to_string(threads) + "' must be >= 0");
-    e.threads = threads;
+    if (given("--threads")) e.threads = threads;
     if (!std::isfinite(alpha) || !(alpha > 0 && alpha < 1))
       throw BadInput("--alpha: '" + std::to_string(alpha) + "' must be in (0, 1)");
-    scene.alpha = alpha;
-    scene.plots = !no_plots;
+    if (given("--alpha")) scene.alpha = alpha;
+    if (no_plots) scene.plots = false;
     if (given("--out")) {
       if (out.empty()) throw BadInput("--out: '' is not a directory name");
       scene.out = out;
     }
-    if (preset_name != scene.name) scene.name = preset_name;
+    if (!given("--scene") && preset_name != scene.name) scene.name = preset_name;
     if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
         given("--speed") || given("--omega-x") || given("--omega-y"))
       scene.name += "+custom";
@@ -190,22 +199,14 @@ int main(int argc, char** argv) {
 
   std::vector<fs::path> written;
   try {
-    using Clock = std::chrono::steady_clock;
     ProgressLine progress(!quiet);
-    const auto samples = run_contact_ensemble(scene.ensemble, std::ref(progress));
+    // Only the stages the scene's outputs need (plan.hpp); figures are written here when planned.
+    GeometryReport report = run_scene(scene, std::ref(progress));
     progress.finish();
-    auto t0 = Clock::now();
-    GeometryReport report = analyse(scene, samples);
-    report.timings_s.emplace_back("analysis", std::chrono::duration<double>(Clock::now() - t0).count());
-    if (scene.plots) {
-      t0 = Clock::now();
-      report.plots = write_plots(scene.out, scene, samples);
-      for (const auto& p : report.plots) written.push_back(scene.out / p);
-      report.timings_s.emplace_back("plots", std::chrono::duration<double>(Clock::now() - t0).count());
-    }
+    for (const auto& p : report.plots) written.push_back(scene.out / p);
     std::cout << format_table(report);
-    write_file_atomic(scene.out / "report.json", to_json(report));
-    std::cout << "wrote " << (scene.out / "report.json").string();
+    write_file_atomic(scene.out / scene.report, to_json(report));
+    std::cout << "wrote " << (scene.out / scene.report).string();
     for (const auto& p : report.plots) std::cout << ", " << p;
     std::cout << "\n";
     return report.rejected() ? 1 : 0;

@@ -1,0 +1,553 @@
+// Scene files (format 1). toml++ is used header-only, in this translation unit only.
+#include "asperity/scene_file.hpp"
+
+#define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
+#include <toml++/toml.h>
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+
+namespace asperity {
+
+namespace {
+
+// Shortest text that reads back as the same double, and is a TOML float (not an integer).
+std::string num(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  std::string s(buf, res.ptr);
+  if (std::isfinite(v) && s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string quote(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (u < 0x20 || u == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", u);
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+// A value as the user wrote it, for messages.
+std::string show(const toml::node& n) {
+  if (auto f = n.as_floating_point()) return num(f->get());
+  if (auto i = n.as_integer()) return std::to_string(i->get());
+  if (auto s = n.as_string()) return quote(s->get());
+  if (auto b = n.as_boolean()) return b->get() ? "true" : "false";
+  if (n.is_array()) return "an array";
+  if (n.is_table()) return "a table";
+  return "a date/time";
+}
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::string: return "string";
+    case toml::node_type::integer: return "integer";
+    case toml::node_type::floating_point: return "float";
+    case toml::node_type::boolean: return "boolean";
+    case toml::node_type::array: return "array";
+    case toml::node_type::table: return "table";
+    default: return "date/time";
+  }
+}
+
+// One TOML table being read: remembers which keys were read, so that every other key is an
+// error naming its full dotted path.
+class Reader {
+ public:
+  Reader(const toml::table& t, std::string path, std::string_view origin) : t_(t), path_(std::move(path)), origin_(origin) {}
+
+  std::string key(std::string_view k) const { return path_.empty() ? std::string(k) : path_ + "." + std::string(k); }
+
+  // "<origin>:<line>: <message>", thrown as SceneError carrying the key.
+  [[noreturn]] void fail(const toml::node* at, const std::string& key, const std::string& message) const {
+    std::string where(origin_);
+    const auto line = at ? at->source().begin.line : t_.source().begin.line;
+    if (line > 0) where += ":" + std::to_string(line);
+    throw SceneError(where + ": " + message, key);
+  }
+  [[noreturn]] void bad(std::string_view k, const std::string& problem) const {
+    fail(t_.get(k), key(k), key(k) + ": " + problem);
+  }
+  [[noreturn]] void unsupported(std::string_view k, const std::string& why) const {
+    const toml::node* n = t_.get(k);
+    fail(n, key(k), "not supported yet: " + key(k) + " = " + (n ? show(*n) : "?") + " (" + why + ")");
+  }
+
+  const toml::node* find(std::string_view k) {
+    used_.insert(std::string(k));
+    return t_.get(k);
+  }
+  bool has(std::string_view k) const { return t_.contains(k); }
+
+  void finish() const {
+    for (auto&& [k, v] : t_)
+      if (!used_.count(std::string(k.str()))) fail(&v, key(k.str()), "unknown key '" + key(k.str()) + "'");
+  }
+
+  std::optional<double> real(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    double v = 0;
+    if (auto f = n->as_floating_point()) {
+      v = f->get();
+    } else if (auto i = n->as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      bad(k, "expected a number, got " + show(*n) + " (" + type_name(*n) + ")");
+    }
+    if (!std::isfinite(v)) bad(k, "must be finite, got " + show(*n));
+    return v;
+  }
+  std::optional<double> positive(std::string_view k, const char* unit) {
+    const auto v = real(k);
+    if (v && !(*v > 0)) bad(k, "must be > 0 " + std::string(unit) + ", got " + show(*t_.get(k)));
+    return v;
+  }
+  // Whole numbers, written as integers or exactly as floats ("1e6").
+  std::optional<std::uint64_t> count(std::string_view k, std::uint64_t lo, std::uint64_t hi) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    long double v = 0;
+    if (auto i = n->as_integer()) {
+      v = static_cast<long double>(i->get());
+    } else if (auto f = n->as_floating_point()) {
+      v = f->get();
+      if (!std::isfinite(f->get())) bad(k, "must be finite, got " + show(*n));
+      if (v != std::floor(v)) bad(k, "must be a whole number, got " + show(*n));
+    } else {
+      bad(k, "expected a whole number, got " + show(*n) + " (" + type_name(*n) + ")");
+    }
+    if (v < static_cast<long double>(lo)) bad(k, "must be >= " + std::to_string(lo) + ", got " + show(*n));
+    if (v > static_cast<long double>(hi)) bad(k, "must be <= " + std::to_string(hi) + ", got " + show(*n));
+    return static_cast<std::uint64_t>(v);
+  }
+  std::optional<bool> boolean(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    if (auto b = n->as_boolean()) return b->get();
+    bad(k, "expected true or false, got " + show(*n) + " (" + type_name(*n) + ")");
+  }
+  std::optional<std::string> text(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto s = n->as_string();
+    if (!s) bad(k, "expected a string, got " + show(*n) + " (" + type_name(*n) + ")");
+    if (s->get().empty()) bad(k, "must not be empty");
+    return s->get();
+  }
+  // One of `choices`, named in the message.
+  std::optional<std::string> choice(std::string_view k, std::initializer_list<std::string_view> choices) {
+    auto v = text(k);
+    if (!v) return v;
+    std::string list;
+    for (auto c : choices) {
+      if (*v == c) return v;
+      list += (list.empty() ? "" : ", ") + quote(c);
+    }
+    bad(k, "expected one of " + list + ", got " + quote(*v));
+  }
+  std::optional<Vec3> vec3(std::string_view k, const char* unit) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto a = n->as_array();
+    if (!a || a->size() != 3) bad(k, std::string("expected an array of 3 numbers [") + unit + "], got " + show(*n));
+    Vec3 v;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const toml::node& e = *a->get(i);
+      if (auto f = e.as_floating_point()) {
+        v[static_cast<Eigen::Index>(i)] = f->get();
+      } else if (auto j = e.as_integer()) {
+        v[static_cast<Eigen::Index>(i)] = static_cast<double>(j->get());
+      } else {
+        bad(k, "element " + std::to_string(i) + " must be a number, got " + show(e));
+      }
+      if (!std::isfinite(v[static_cast<Eigen::Index>(i)])) bad(k, "element " + std::to_string(i) + " must be finite, got " + show(e));
+    }
+    return v;
+  }
+  std::optional<std::vector<double>> reals(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto a = n->as_array();
+    if (!a || a->empty()) bad(k, "expected a non-empty array of numbers, got " + show(*n));
+    std::vector<double> out;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::node& e = *a->get(i);
+      double v = 0;
+      if (auto f = e.as_floating_point()) v = f->get();
+      else if (auto j = e.as_integer()) v = static_cast<double>(j->get());
+      else bad(k, "element " + std::to_string(i) + " must be a number, got " + show(e));
+      if (!std::isfinite(v)) bad(k, "element " + std::to_string(i) + " must be finite, got " + show(e));
+      out.push_back(v);
+    }
+    return out;
+  }
+  // A sub-table (a [section] or an inline { ... } table).
+  std::optional<Reader> table(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto t = n->as_table();
+    if (!t) bad(k, "expected a table, got " + show(*n) + " (" + type_name(*n) + ")");
+    return Reader(*t, key(k), origin_);
+  }
+  [[noreturn]] void missing(std::string_view k, const std::string& hint) const {
+    fail(nullptr, key(k), key(k) + ": missing (" + hint + ")");
+  }
+
+ private:
+  const toml::table& t_;
+  std::string path_;
+  std::string_view origin_;
+  std::set<std::string> used_;
+};
+
+constexpr std::uint64_t kMaxAsperities = (std::uint64_t{1} << 32) - 1;  // geometry.hpp: N < 2^32
+constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
+
+// THE mapping from a scene file to a Scene: every section and key of format 1 is read here, and
+// nowhere else. New engine features (mesh bodies, radius distributions, bounce experiments, ...)
+// are wired in by replacing the matching `unsupported(...)` with a field of Scene.
+Scene scene_from_toml(const toml::table& root, std::string_view origin) {
+  Reader top(root, "", origin);
+  Scene s;
+  const auto format = top.count("format", 1, std::numeric_limits<std::int64_t>::max());
+  if (!format) top.missing("format", "write format = " + std::to_string(kSceneFormatVersion) + " as the first line");
+  if (*format != kSceneFormatVersion)
+    top.bad("format", "this library reads format " + std::to_string(kSceneFormatVersion) + ", got " +
+                          std::to_string(*format));
+  s.name = top.text("name").value_or("custom");
+
+  // [body]
+  double R = s.ensemble.sphere.radius;
+  if (auto body = top.table("body")) {
+    const auto kind = body->choice("kind", {"sphere", "mesh"}).value_or("sphere");
+    if (kind == "mesh") {
+      // Checked so that a typo is reported before the missing feature.
+      body->text("mesh");
+      body->positive("scale", "(factor)");
+      body->unsupported("kind", "bodies from meshes/ are not in the engine yet; use \"sphere\"");
+    }
+    for (const char* k : {"mesh", "scale"})
+      if (body->has(k)) body->bad(k, "only for kind = \"mesh\"");
+    if (auto r = body->positive("radius", "m")) R = *r;
+    body->finish();
+  }
+  s.ensemble.sphere.radius = R;
+
+  // [material]
+  auto& impact = s.ensemble.impact;
+  if (auto mat = top.table("material")) {
+    if (auto d = mat->positive("density", "kg/m^3")) impact.density = *d;
+    if (auto e = mat->real("eps_t")) {
+      if (*e < -1 || *e > 1) mat->bad("eps_t", "must be in [-1, 1], got " + num(*e));
+      impact.eps_t = *e;
+    }
+    if (auto rest = mat->table("restitution")) {
+      const auto model = rest->choice("model", {"viscoelastic", "constant"});
+      if (!model) rest->missing("model", "\"viscoelastic\" (with beta) or \"constant\" (with value)");
+      if (*model == "viscoelastic") {
+        const auto beta = rest->positive("beta", "(s/m)^(1/5)");
+        if (!beta) rest->missing("beta", "Pade [1/4] constant of Eq. 9, e.g. 0.0467 for steel");
+        impact.beta = *beta;
+      } else {
+        if (auto v = rest->real("value"); v && (*v < 0 || *v > 1))
+          rest->bad("value", "must be in [0, 1], got " + num(*v));
+        rest->unsupported("model", "impacts use the viscoelastic model only");
+      }
+      rest->finish();
+    }
+    mat->finish();
+  }
+
+  // [asperities]
+  if (auto asp = top.table("asperities")) {
+    const auto n = asp->count("count", 1, kMaxAsperities);
+    const auto eta = asp->positive("areal_density", "per m^2");
+    if (n && eta) asp->bad("areal_density", "give either count or areal_density, not both");
+    if (n) s.ensemble.sphere.asperities = *n;
+    if (eta) {
+      const double count = std::round(*eta * 4.0 * std::numbers::pi * R * R);
+      if (!(count >= 1) || count > double(kMaxAsperities))
+        asp->bad("areal_density", num(*eta) + " per m^2 on a sphere of radius " + num(R) + " m gives " + num(count) +
+                                      " asperities; need 1 .. 2^32-1");
+      s.ensemble.sphere.asperities = static_cast<std::uint64_t>(count);
+    }
+    if (auto rad = asp->table("radius")) {
+      const auto dist = rad->choice("distribution", {"fixed", "lognormal", "levels"});
+      if (!dist) rad->missing("distribution", "\"fixed\" (with value), \"lognormal\" or \"levels\"");
+      if (*dist == "fixed") {
+        const auto a = rad->positive("value", "m");
+        if (!a) rad->missing("value", "the asperity radius a [m]");
+        if (*a >= R) rad->bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
+        s.ensemble.sphere.asperity_radius = *a;
+      } else if (*dist == "lognormal") {
+        rad->positive("median", "m");
+        rad->positive("sigma", "(log-space)");
+        rad->unsupported("distribution", "the engine has equal asperity radii only; use \"fixed\"");
+      } else {
+        const auto radii = rad->reals("radii");
+        const auto fractions = rad->reals("fractions");
+        if (radii)
+          for (double r : *radii)
+            if (!(r > 0)) rad->bad("radii", "every radius must be > 0 m, got " + num(r));
+        if (fractions) {
+          double sum = 0;
+          for (double f : *fractions) {
+            if (!(f > 0)) rad->bad("fractions", "every fraction must be > 0, got " + num(f));
+            sum += f;
+          }
+          if (std::abs(sum - 1.0) > 1e-9) rad->bad("fractions", "must sum to 1, got " + num(sum));
+        }
+        if (radii && fractions && radii->size() != fractions->size())
+          rad->bad("fractions", "needs one fraction per radius (" + std::to_string(radii->size()) + "), got " +
+                                    std::to_string(fractions->size()));
+        rad->unsupported("distribution", "the engine has equal asperity radii only; use \"fixed\"");
+      }
+      rad->finish();
+    }
+    asp->finish();
+  }
+  if (s.ensemble.sphere.asperity_radius >= R)
+    top.fail(nullptr, "body.radius",
+             "body.radius: " + num(R) + " m must exceed the asperity radius " + num(s.ensemble.sphere.asperity_radius) + " m");
+
+  // [ensemble]
+  auto& e = s.ensemble;
+  if (auto ens = top.table("ensemble")) {
+    if (auto m = ens->choice("mode", {"fresh", "fixed"})) e.mode = parse_mode(*m);
+    if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
+    if (auto k = ens->count("spheres", 1, kMaxDrops)) {
+      if (e.mode == Mode::fresh && *k != 1)
+        ens->bad("spheres", "only mode = \"fixed\" uses explicit spheres (fresh mode draws a new sphere per drop), got " +
+                                std::to_string(*k));
+      e.spheres = *k;
+    }
+    if (e.mode == Mode::fixed && e.drops % e.spheres != 0)
+      ens->bad("drops", std::to_string(e.drops) + " must be a multiple of ensemble.spheres = " + std::to_string(e.spheres));
+    if (const toml::node* seed = ens->find("seed")) {
+      // Integers up to 2^63 - 1; larger 64-bit seeds as a string of digits.
+      if (auto i = seed->as_integer()) {
+        if (i->get() < 0) ens->bad("seed", "must be >= 0, got " + show(*seed));
+        e.seed = static_cast<std::uint64_t>(i->get());
+      } else if (auto str = seed->as_string()) {
+        const std::string& t = str->get();
+        const auto res = std::from_chars(t.data(), t.data() + t.size(), e.seed);
+        if (t.empty() || res.ec != std::errc() || res.ptr != t.data() + t.size())
+          ens->bad("seed", "expected a non-negative 64-bit integer, got " + show(*seed));
+      } else {
+        ens->bad("seed", "expected a non-negative integer, got " + show(*seed) + " (" + type_name(*seed) + ")");
+      }
+    }
+    if (auto b = ens->choice("backend", {"auto", "brute", "kdtree", "cgal", "fcl", "grid"})) {
+      s.backend_auto = *b == "auto";
+      if (!s.backend_auto) e.backend = parse_backend(*b);
+    }
+    if (auto t = ens->count("threads", 0, 4096)) e.threads = static_cast<int>(*t);
+    ens->finish();
+  }
+
+  // [experiment]
+  bool impacts = false;
+  if (auto ex = top.table("experiment")) {
+    const auto kind = ex->choice("kind", {"contact", "impact", "bounce"}).value_or("contact");
+    if (kind == "bounce") ex->unsupported("kind", "bounce sequences are not in the engine yet");
+    impacts = kind == "impact";
+    if (impacts) {
+      const auto V = ex->vec3("V", "m/s");
+      const auto Omega = ex->vec3("Omega", "rad/s");
+      if (!V) ex->missing("V", "velocity before the impact [m/s], e.g. [0, 0, -1.3]");
+      if (!Omega) ex->missing("Omega", "spin before the impact [rad/s], e.g. [0.2, 0, 0]");
+      if (!((*V)[2] < 0)) ex->bad("V", "the body must approach the plate below it (V.z < 0), got V.z = " + num((*V)[2]));
+      if ((*V)[0] != 0 || (*V)[1] != 0)
+        ex->unsupported("V", "only vertical impacts V = [0, 0, -u] are in the engine yet");
+      impact.speed = -(*V)[2];
+      impact.omega = *Omega;
+    } else {
+      for (const char* k : {"V", "Omega"})
+        if (ex->has(k)) ex->bad(k, "only for kind = \"impact\"");
+    }
+    ex->finish();
+  }
+  impact.enabled = impacts;
+
+  // [outputs]
+  if (auto out = top.table("outputs")) {
+    if (auto c = out->boolean("contact")) s.contact_stats = *c;
+    if (auto r = out->boolean("restitution")) {
+      if (*r && !impacts) out->bad("restitution", "true needs experiment.kind = \"impact\"");
+      s.restitution_stats = *r;
+    }
+    if (!s.contact_stats && !(impacts && s.restitution_stats))
+      out->bad("contact", "nothing to compute: request contact = true, or restitution = true with an impact experiment");
+    if (auto p = out->boolean("plots")) s.plots = *p;
+    if (auto a = out->real("alpha")) {
+      if (!(*a > 0 && *a < 1)) out->bad("alpha", "must be in (0, 1), got " + num(*a));
+      s.alpha = *a;
+    }
+    if (auto d = out->text("dir")) s.out = *d;
+    if (auto r = out->text("report")) {
+      if (r->find('/') != std::string::npos || *r == "." || *r == "..")
+        out->bad("report", "must be a file name inside outputs.dir, got " + quote(*r));
+      s.report = *r;
+    }
+    out->finish();
+  }
+  top.finish();
+
+  // The engine's own checks, as a net: the keys above should already have caught everything.
+  try {
+    validate(s);
+  } catch (const std::invalid_argument& ex) {
+    top.fail(nullptr, "", ex.what());
+  }
+  return s;
+}
+
+// toml++ 3.3 (Debian 12) violates its own precondition on a table header whose name does not
+// start with a key character ("[\n", "[[=", "[[[1]]"): an assertion failure in debug builds,
+// undefined behaviour (__builtin_assume) in clang release builds (upstream marzer/tomlplusplus
+// PR #301). Such headers are never valid TOML, so they are refused here, before toml++ sees them.
+// Returns the 1-based line of the first one, 0 if there is none. Tracks strings, comments and
+// multi-line arrays so that a '[' inside a value is not taken for a header.
+std::size_t bad_table_header(std::string_view t) {
+  std::size_t line = 1;
+  bool line_start = true, in_header = false;
+  int depth = 0;  // nesting of [ and { inside a value
+  const std::size_t n = t.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = t[i];
+    if (c == '\n') {
+      ++line;
+      in_header = false;
+      if (depth == 0) line_start = true;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') continue;
+    if (c == '#') {
+      while (i + 1 < n && t[i + 1] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      line_start = false;
+      if (i + 2 < n && t[i + 1] == c && t[i + 2] == c) {  // multi-line string
+        const std::string_view close = c == '"' ? std::string_view("\"\"\"") : std::string_view("'''");
+        i += 3;
+        while (i < n && t.substr(i, 3) != close) {
+          if (c == '"' && t[i] == '\\' && i + 1 < n) ++i;  // an escape (maybe a line-ending backslash)
+          if (t[i] == '\n') ++line;
+          ++i;
+        }
+        i += 2;  // at the last quote of the closing triple (the loop's ++i steps past it)
+      } else {
+        ++i;
+        while (i < n && t[i] != c && t[i] != '\n') {
+          if (c == '"' && t[i] == '\\') ++i;
+          ++i;
+        }
+        if (i < n && t[i] == '\n') --i;  // unterminated: let the newline be counted
+      }
+      continue;
+    }
+    if (line_start && depth == 0 && c == '[') {
+      std::size_t j = i + 1;
+      if (j < n && t[j] == '[') ++j;
+      while (j < n && (t[j] == ' ' || t[j] == '\t')) ++j;
+      if (j < n) {
+        const char k = t[j];
+        const bool key_start = (k >= 'A' && k <= 'Z') || (k >= 'a' && k <= 'z') || (k >= '0' && k <= '9') ||
+                               k == '_' || k == '-' || k == '"' || k == '\'';
+        if (!key_start) return line;
+      }
+      in_header = true;
+      line_start = false;
+      i = j - 1;
+      continue;
+    }
+    line_start = false;
+    if (in_header) continue;
+    if (c == '[' || c == '{') ++depth;
+    else if ((c == ']' || c == '}') && depth > 0) --depth;
+  }
+  return 0;
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view toml_text, std::string_view origin) {
+  if (const std::size_t line = bad_table_header(toml_text))
+    throw SceneError(std::string(origin) + ":" + std::to_string(line) +
+                         ": TOML syntax error: a table header must start with a key, e.g. [body]",
+                     "");
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, std::string(origin));
+  } catch (const toml::parse_error& e) {
+    throw SceneError(std::string(origin) + ":" + std::to_string(e.source().begin.line) + ": TOML syntax error: " +
+                         std::string(e.description()),
+                     "");
+  }
+  return scene_from_toml(root, origin);
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  std::ifstream f(file, std::ios::binary);
+  std::error_code ec;
+  if (!f || std::filesystem::is_directory(file, ec)) throw SceneError("cannot read scene file '" + file.string() + "'", "");
+  std::ostringstream text;
+  text << f.rdbuf();
+  if (!f && !f.eof()) throw SceneError("cannot read scene file '" + file.string() + "'", "");
+  return parse_scene(text.str(), file.string());
+}
+
+std::string to_toml(const Scene& s) {
+  const auto& e = s.ensemble;
+  const auto& x = e.impact;
+  std::ostringstream os;
+  os << "# asperity scene (README \"Scenes\")\n";
+  os << "format = " << kSceneFormatVersion << "\n";
+  os << "name = " << quote(s.name) << "\n\n";
+  os << "[body]\nkind = \"sphere\"\nradius = " << num(e.sphere.radius) << "\n\n";
+  os << "[material]\ndensity = " << num(x.density) << "\neps_t = " << num(x.eps_t)
+     << "\nrestitution = { model = \"viscoelastic\", beta = " << num(x.beta) << " }\n\n";
+  os << "[asperities]\ncount = " << e.sphere.asperities << "\nradius = { distribution = \"fixed\", value = "
+     << num(e.sphere.asperity_radius) << " }\n\n";
+  os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\n";
+  if (e.mode == Mode::fixed) os << "spheres = " << e.spheres << "\n";  // fresh mode has no explicit spheres
+  os << "seed = ";
+  if (e.seed > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+    os << quote(std::to_string(e.seed));
+  else
+    os << e.seed;
+  os << "\nbackend = \"" << (s.backend_auto ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
+     << e.threads << "\n\n";
+  if (x.enabled) {
+    os << "[experiment]\nkind = \"impact\"\nV = [0.0, 0.0, " << num(-x.speed) << "]\nOmega = [" << num(x.omega.x())
+       << ", " << num(x.omega.y()) << ", " << num(x.omega.z()) << "]\n\n";
+  } else {
+    os << "[experiment]\nkind = \"contact\"\n\n";
+  }
+  os << "[outputs]\ncontact = " << (s.contact_stats ? "true" : "false") << "\n";
+  if (x.enabled || !s.restitution_stats) os << "restitution = " << (s.restitution_stats ? "true" : "false") << "\n";
+  os << "plots = " << (s.plots ? "true" : "false") << "\nalpha = " << num(s.alpha) << "\ndir = " << quote(s.out.string())
+     << "\nreport = " << quote(s.report) << "\n";
+  return os.str();
+}
+
+}  // namespace asperity
