@@ -1,0 +1,276 @@
+// Numerical stability at the extremes (ctest label `stress`): every parameter pushed to the edge
+// of its supported range gives a finite, correct answer or a clear error, never NaN, a wrong
+// asperity or a crash. References are computed in long double (x87, 64-bit mantissa), 11 bits
+// more than the double under test. Each test runs in seconds, also under ASan+UBSan.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "asperity/contact.hpp"
+#include "asperity/ensemble.hpp"
+#include "asperity/impact.hpp"
+#include "asperity/orientation.hpp"
+#include "asperity/random.hpp"
+#include "asperity/report.hpp"
+#include "asperity/restitution.hpp"
+#include "asperity/scene.hpp"
+
+using namespace asperity;
+
+namespace {
+
+using LD = long double;
+static_assert(std::numeric_limits<LD>::digits >= 64, "the references need x87 extended precision");
+
+// |u - d|^2 in long double from the same double inputs: the exact ordering of the stored centres
+// up to 2^-64 relative.
+LD key_ld(const Vec3& u, const Vec3& d) {
+  const LD x = LD(u.x()) - d.x(), y = LD(u.y()) - d.y(), z = LD(u.z()) - d.z();
+  return x * x + y * y + z * z;
+}
+
+// Reference lowest asperity in long double (ties -> lowest index).
+std::uint32_t lowest_ld(std::span<const Vec3> c, const Vec3& d) {
+  std::uint32_t best = 0;
+  LD bk = key_ld(c[0], d);
+  for (std::uint32_t i = 1; i < c.size(); ++i) {
+    const LD k = key_ld(c[i], d);
+    if (k < bk) bk = k, best = i;
+  }
+  return best;
+}
+
+// The double key of a centre is within a few ulp of its exact value: a double answer that
+// differs from the reference is only allowed when the two exact keys are closer than that.
+bool resolvable(LD k1, LD k2) { return std::fabs(k1 - k2) > 8 * std::numeric_limits<double>::epsilon() * std::max(k1, k2); }
+
+const std::vector<double> kRatios = {1e-9, 1e-7, 1e-5, 1e-3, 1e-1};  // rho/varrho
+const std::vector<std::uint64_t> kCounts = {1, 2, 10, 1000, 100000, 10000000, 1000000000, 4294967295};
+
+}  // namespace
+
+// r_xy = R |u x d| has full relative precision at every N and rho/varrho (no sqrt(R^2 - z^2)),
+// r_z = -(R u.d + a) too; the naive formula loses everything at large N, which is the power check.
+TEST(Stress, ContactVectorFiniteAndAccurateOverRatioAndN) {
+  const double R = 3e-3;
+  double worst_rxy = 0, worst_rz = 0, naive_worst = 0;
+  for (double ratio : kRatios)
+    for (std::uint64_t N : kCounts)
+      for (std::uint64_t drop = 0; drop < 200; ++drop) {
+        const double a = ratio * R;
+        const auto cap = fresh_cap(N, drop, 7);
+        const Vec3 d(0, 0, -1);
+        const Nearest n = brute_lowest(cap, d);
+        const Contact c = make_contact(n, cap[n.index], Rotation::Identity(), R, a);
+        ASSERT_TRUE(c.r.allFinite() && std::isfinite(c.r_xy)) << "N " << N << " ratio " << ratio;
+        ASSERT_TRUE(N == 1 ? std::isinf(c.gap) : std::isfinite(c.gap) && c.gap >= 0);
+        const Vec3& u = cap[n.index];
+        const LD sx = LD(u.y()) * d.z() - LD(u.z()) * d.y(), sy = LD(u.z()) * d.x() - LD(u.x()) * d.z(),
+                 sz = LD(u.x()) * d.y() - LD(u.y()) * d.x();
+        const LD rxy = LD(R) * std::sqrt(sx * sx + sy * sy + sz * sz);
+        const LD rz = -(LD(R) * (LD(u.x()) * d.x() + LD(u.y()) * d.y() + LD(u.z()) * d.z()) + a);
+        if (rxy > 0) worst_rxy = std::max(worst_rxy, double(std::fabs(c.r_xy - rxy) / rxy));
+        // r_z relative to the body size: near the equator (N = 1) r_z itself passes through 0.
+        worst_rz = std::max(worst_rz, double(std::fabs(c.r.z() - rz) / (R + a)));
+        const double z = R * u.dot(d);
+        const double naive = std::sqrt(std::max(0.0, R * R - z * z));
+        if (rxy > 0) naive_worst = std::max(naive_worst, double(std::fabs(naive - rxy) / rxy));
+        // The lowest of the cap is the true lowest in extended precision.
+        if (cap.size() == 2 && n.index != lowest_ld(cap, d)) {
+          EXPECT_FALSE(resolvable(key_ld(cap[0], d), key_ld(cap[1], d))) << "N " << N << " drop " << drop;
+        }
+      }
+  std::printf("relative error vs long double: r_xy %.2e, r_z %.2e; naive sqrt(R^2 - z^2): %.2e\n", worst_rxy,
+              worst_rz, naive_worst);
+  EXPECT_LT(worst_rxy, 1e-15);
+  EXPECT_LT(worst_rz, 1e-15);
+  EXPECT_GT(naive_worst, 1e-6);  // the formula the library avoids would fail this test
+}
+
+// Explicit spheres up to 10^6 asperities (10^7 in bench/): every backend's lowest is the
+// long-double lowest whenever the two are resolvable, at the smallest and largest rho/varrho.
+TEST(Stress, ExplicitSphereLowestIsTheTrueOne) {
+  for (std::uint64_t N : {1ull, 2ull, 1000ull, 1000000ull}) {
+    const auto body = make_rough_sphere({N, 3e-3, 3e-3 * 1e-9}, 11, 0);
+    const auto grid = make_contact_query(Backend::grid, body.centres);
+    const auto tree = make_contact_query(Backend::kdtree, body.centres);
+    int checked = 0;
+    for (std::uint64_t j = 0; j < 40; ++j) {
+      Stream s(11, Purpose::test, j);
+      const Rotation q = random_rotation(s);
+      const Vec3 d = body_down(q);
+      const Nearest b = brute_lowest(body.centres, d);
+      EXPECT_EQ(grid->lowest(d), b);
+      EXPECT_EQ(tree->lowest(d), b);
+      const std::uint32_t ref = lowest_ld(body.centres, d);
+      if (ref != b.index) {
+        EXPECT_FALSE(resolvable(key_ld(body.centres[ref], d), key_ld(body.centres[b.index], d))) << N;
+      }
+      for (double a : {3e-3 * 1e-9, 3e-3 * 1e-1}) {
+        const Contact c = make_contact(b, body.centres[b.index], q, 3e-3, a);
+        EXPECT_TRUE(c.r.allFinite() && std::isfinite(c.r_xy));
+      }
+      ++checked;
+    }
+    EXPECT_EQ(checked, 40);
+  }
+}
+
+// Near-ties built on purpose: two asperities whose keys differ by k ulp (k = 0 is an exact tie,
+// resolved by index). Every backend picks the same one, and the right one.
+TEST(Stress, ConstructedNearTiesBetweenTheTwoLowest) {
+  const Vec3 d(0, 0, -1);
+  for (double theta : {1e-7, 1e-5, 1e-3, 0.3}) {
+    for (int ulps : {0, 1, 2, 16, 1 << 20}) {
+      // Centre 1 at polar angle theta, azimuth 0; centre 2 on the opposite side with its
+      // key nudged up by `ulps` ulp (search the azimuth-free angle for that key).
+      std::vector<Vec3> c;
+      for (int i = 0; i < 50; ++i) c.push_back(uniform_on_sphere(0.5 + 0.009 * i, 0.01 * i));  // far away
+      const Vec3 u1(std::sin(theta), 0, -std::cos(theta));
+      const double k1 = contact_key(u1, d);
+      double target = k1;
+      for (int i = 0; i < ulps; ++i) target = std::nextafter(target, 2.0);
+      // Mirror image has the same key (bit for bit: the key squares x); nudge z until the key hits target.
+      Vec3 u2(-u1.x(), 0, u1.z());
+      for (int it = 0; it < 4096 && contact_key(u2, d) < target; ++it) u2.z() = std::nextafter(u2.z(), 1.0);
+      const double k2 = contact_key(u2, d);
+      c.push_back(u2);  // index 50: the higher one (or the tie) comes first
+      c.push_back(u1);  // index 51
+      const std::uint32_t expect = k1 < k2 ? 51 : 50;
+      for (Backend be : all_backends()) {
+        const auto q = make_contact_query(be, c);
+        const Nearest n = q->lowest(d);
+        EXPECT_EQ(n.index, expect) << to_string(be) << " theta " << theta << " ulps " << ulps;
+        EXPECT_EQ(n.runner_up, expect == 51 ? 50u : 51u) << to_string(be);
+      }
+    }
+  }
+}
+
+// eps_n of Eq. 9 over v in [1e-12, 1e8] m/s: finite, in [0, 1], non-increasing, -> 1 at v -> 0.
+TEST(Stress, PadeRestitutionOverTwentyDecades) {
+  const auto e = viscoelastic_pade14(0.0467);
+  double prev = 1.0;
+  for (double lv = -12; lv <= 8.0001; lv += 0.05) {
+    const double v = std::pow(10.0, lv), x = (*e)(v);
+    ASSERT_TRUE(std::isfinite(x) && x >= 0 && x <= 1) << v;
+    EXPECT_LE(x, prev + 1e-15) << v;
+    prev = x;
+  }
+  EXPECT_GT((*e)(1e-12), 0.99);
+  EXPECT_EQ((*e)(0.0), 1.0);
+  EXPECT_THROW((*e)(std::numeric_limits<double>::quiet_NaN()), std::invalid_argument);
+  EXPECT_THROW((*e)(-1e-300), std::invalid_argument);
+}
+
+// Impacts at extreme speeds, spins up to 1e4 rad/s and grazing incidence: the closed form agrees
+// with the 3x3 solve, everything is finite; no impact is nullopt, V.n = 0 a clear error.
+TEST(Stress, ImpactsFiniteAtExtremeSpeedsSpinsAndGrazing) {
+  const double R = 3e-3, M = 4.0 / 3.0 * 3.14159265358979 * R * R * R * 7850, I = 0.4 * M * R * R;
+  const auto body = RigidBody::sphere(M, R);
+  const auto e = viscoelastic_pade14(0.0467);
+  int solved = 0, none = 0;
+  for (double u : {1e-12, 1e-6, 1.0, 1e4, 1e8})
+    for (double w : {0.0, 1e-3, 1.0, 1e2, 1e4})
+      for (double tilt : {0.0, 1e-300, 1e-12, 1e-3, 1.0}) {  // horizontal velocity / u: grazing when large
+        ImpactState s;
+        s.V = Vec3(u / std::max(tilt, 1e-300) * (tilt > 0), 0, -u);
+        if (!s.V.allFinite()) continue;
+        s.Omega = Vec3(-w, 0.5 * w, 0);  // spins the contact point upwards
+        s.r = Vec3(1.7e-5, -0.9e-5, -(R + 6.5e-7));
+        const auto a = solve_impact_isotropic(M, I, s, 0.9, 1.0), b = solve_impact(body, s, *e);
+        ASSERT_EQ(a.has_value(), b.has_value());
+        if (!a) {
+          ++none;
+          EXPECT_GE((s.V + s.Omega.cross(s.r)).z(), 0.0);
+          continue;
+        }
+        ++solved;
+        for (const auto* r : {&*a, &*b}) {
+          EXPECT_TRUE(r->P.allFinite() && r->V_after.allFinite() && r->Omega_after.allFinite()) << u << " " << w;
+          EXPECT_TRUE(std::isfinite(r->eps) && std::isfinite(r->eps_n)) << u << " " << w;
+        }
+        const auto g = solve_impact(body, s, 0.9, 1.0);
+        EXPECT_LE((g->P - a->P).norm(), 1e-9 * g->P.norm()) << u << " " << w << " " << tilt;
+      }
+  EXPECT_GT(solved, 50);
+  EXPECT_GT(none, 5);  // large spins at small speeds: the contact point moves up, no impact
+  ImpactState up;  // moving away from the plate
+  up.V = Vec3(0, 0, 1);
+  EXPECT_FALSE(solve_impact(body, up, 0.9).has_value());
+  ImpactState flat;  // V.n = 0: eps of Eq. 1 undefined
+  flat.V = Vec3(1, 0, 0);
+  EXPECT_THROW(solve_impact(body, flat, 0.9), std::invalid_argument);
+  ImpactState graze;  // V.n -> 0-: finite, and eps stays bounded by the contact law
+  graze.V = Vec3(1, 0, -1e-300);
+  const auto g = solve_impact(body, graze, *e);
+  ASSERT_TRUE(g.has_value());
+  EXPECT_TRUE(std::isfinite(g->eps) && g->P.allFinite());
+}
+
+// Whole ensembles at the edges of the supported ranges: finite samples, or a clear error.
+TEST(Stress, EnsemblesAtTheEdgesOfTheSupportedRanges) {
+  struct Case {
+    double R, a, speed, omega;
+    std::uint64_t N;
+  };
+  for (const Case& k : {Case{3e-3, 3e-12, 1e-12, 1e4, 100000}, Case{3e-3, 3e-4, 1e8, 0.2, 1},
+                        Case{kMaxLength, kMaxLength * 1e-9, 1.3, 1e-6, 4294967295},
+                        Case{1e-6, kMinLength, 1e-3, 1e4, 1000}}) {
+    EnsembleConfig c;
+    c.sphere = {k.N, k.R, k.a};
+    c.drops = 500;
+    c.impact.enabled = true;
+    c.impact.speed = k.speed;
+    c.impact.omega = Vec3(k.omega, 0, 0);
+    const auto s = run_contact_ensemble(c);
+    for (const auto* v : {&s.r_x, &s.r_y, &s.r_z, &s.r_xy, &s.eps, &s.omega_x_after, &s.eps_n})
+      for (double x : *v) ASSERT_TRUE(std::isfinite(x)) << k.R << " " << k.a << " " << k.speed;
+    EXPECT_EQ(s.eps.size() + s.no_impacts, c.drops);
+    Scene scene;
+    scene.ensemble = c;
+    const auto r = analyse(scene, s);  // never throws for a validated scene
+    EXPECT_FALSE(to_json(r).empty());
+  }
+  EnsembleConfig bad;
+  bad.impact.enabled = true;
+  for (auto edit : std::vector<void (*)(EnsembleConfig&)>{
+           [](EnsembleConfig& c) { c.sphere.radius = 2 * kMaxLength; },
+           [](EnsembleConfig& c) { c.sphere.asperity_radius = kMinLength / 2; },
+           [](EnsembleConfig& c) { c.impact.speed = 2 * kMaxSpeed; },
+           [](EnsembleConfig& c) { c.impact.omega = Vec3(1e300, 0, 0); },
+           [](EnsembleConfig& c) { c.impact.density = 1e-300; },  // inertia underflows
+           [](EnsembleConfig& c) { c.threads = kMaxThreads + 1; }}) {
+    EnsembleConfig c = bad;
+    edit(c);
+    EXPECT_THROW(validate(c), std::invalid_argument);
+  }
+}
+
+// Bit-identical results for 1 and 2 threads and for repeated runs, fresh and fixed, with impacts;
+// the report is compared as JSON text with the wall-clock timings removed.
+TEST(Stress, ReportsBitIdenticalForThreadCountsAndRepeats) {
+  auto report = [](Mode mode, int threads) {
+    Scene scene = preset("fig4");
+    auto& e = scene.ensemble;
+    e.mode = mode;
+    e.sphere.asperities = 2000;
+    e.drops = 4000;
+    e.spheres = 4;
+    e.threads = threads;
+    auto j = nlohmann::json::parse(to_json(analyse(scene, run_contact_ensemble(e))));
+    j.erase("timings_s");
+    j["parameters"].erase("threads");
+    return j.dump();
+  };
+  for (Mode m : {Mode::fresh, Mode::fixed}) {
+    const std::string one = report(m, 1), two = report(m, 2), again = report(m, 2);
+    EXPECT_EQ(one, two) << to_string(m);
+    EXPECT_EQ(two, again) << to_string(m);
+  }
+}
