@@ -274,3 +274,90 @@ TEST(Stress, ReportsBitIdenticalForThreadCountsAndRepeats) {
     EXPECT_EQ(two, again) << to_string(m);
   }
 }
+
+namespace {
+
+// The decisions a single-precision implementation would make for the two lowest candidates:
+// the chord key |u - d|^2 in float (the product's formula, centres stored as float) and the
+// height u.d in float (the naive formula). true = picks candidate 0.
+bool float_chord_picks_first(const Vec3& u0, const Vec3& u1, const Vec3& d) {
+  auto key = [&](const Vec3& u) {
+    const float x = float(u.x()) - float(d.x()), y = float(u.y()) - float(d.y()), z = float(u.z()) - float(d.z());
+    return x * x + y * y + z * z;
+  };
+  const float k0 = key(u0), k1 = key(u1);
+  return k0 < k1 || k0 == k1;  // ties -> lowest index
+}
+bool float_height_picks_first(const Vec3& u0, const Vec3& u1, const Vec3& d) {
+  auto h = [&](const Vec3& u) { return float(u.x()) * float(d.x()) + float(u.y()) * float(d.y()) + float(u.z()) * float(d.z()); };
+  return h(u0) >= h(u1);
+}
+bool double_picks_first(const Vec3& u0, const Vec3& u1, const Vec3& d) {
+  return !key_less(contact_key(u1, d), 1, contact_key(u0, d), 0);
+}
+
+}  // namespace
+
+// A measurement, reported on stdout (copied to bench/RESULTS.md): how often single precision
+// picks the wrong one of the two lowest asperities, against N (fresh spheres, 2e5 drops per N)
+// and against the relative runner-up gap g = (k2 - k1)/k1 (pairs built at that gap, 2e4 per g).
+// Asserted: double agrees with the long-double reference whenever the reference can tell the two
+// apart by more than the keys' rounding (g > 8 eps), at every N and g; and the measurement has
+// power: the naive float height fails often at large N.
+TEST(Stress, FloatVersusDoubleWrongAsperityRate) {
+  const Vec3 d(0, 0, -1);
+  std::printf("%-12s %-12s %-14s %-14s %-10s\n", "N", "drops", "float-height", "float-chord", "double");
+  double height_at_1e7 = 0;
+  for (std::uint64_t N : {1000ull, 10000ull, 100000ull, 1000000ull, 10000000ull, 100000000ull, 1000000000ull,
+                          4294967295ull}) {
+    const std::uint64_t drops = 200000;
+    std::uint64_t wrong_h = 0, wrong_c = 0, wrong_d = 0;
+    for (std::uint64_t i = 0; i < drops; ++i) {
+      auto cap = fresh_cap(N, i, 3);
+      // cap[0] is the lowest by construction: alternate the order, or ties resolved by index
+      // would be right by accident.
+      if (i & 1) std::swap(cap[0], cap[1]);
+      const bool truth = key_ld(cap[0], d) <= key_ld(cap[1], d);
+      wrong_h += float_height_picks_first(cap[0], cap[1], d) != truth;
+      wrong_c += float_chord_picks_first(cap[0], cap[1], d) != truth;
+      if (double_picks_first(cap[0], cap[1], d) != truth) {
+        ++wrong_d;
+        EXPECT_FALSE(resolvable(key_ld(cap[0], d), key_ld(cap[1], d))) << "N " << N << " drop " << i;
+      }
+    }
+    std::printf("%-12llu %-12llu %-14.3g %-14.3g %-10.3g\n", (unsigned long long)N, (unsigned long long)drops,
+                double(wrong_h) / drops, double(wrong_c) / drops, double(wrong_d) / drops);
+    if (N == 10000000ull) height_at_1e7 = double(wrong_h) / drops;
+  }
+  EXPECT_GT(height_at_1e7, 0.01);  // power: the measurement sees float's failures
+
+  std::printf("\n%-10s %-10s %-14s %-14s %-10s\n", "gap g", "pairs", "float-height", "float-chord", "double");
+  for (double g = 1e-1; g > 1e-15; g /= 10) {
+    const int pairs = 20000;
+    int wrong_h = 0, wrong_c = 0, wrong_d = 0, unresolved = 0;
+    for (int i = 0; i < pairs; ++i) {
+      Stream s(5, Purpose::test, std::uint64_t(i), std::uint64_t(-std::log10(g)));
+      // Lowest at x1 ~ Exp(1)/N (N = 1e6), the other at x2 = x1 (1 + g), random azimuths.
+      const double x1 = -std::log(s.uniform()) / 1e6, x2 = x1 * (1 + g);
+      auto at = [](double x, double phi) {
+        const double st = 2.0 * std::sqrt(x * (1.0 - x));
+        return Vec3(st * std::cos(phi), st * std::sin(phi), -(1.0 - 2.0 * x));
+      };
+      Vec3 u0 = at(x1, 6.283185307179586 * s.uniform0()), u1 = at(x2, 6.283185307179586 * s.uniform0());
+      if (i & 1) std::swap(u0, u1);  // the lower one first only half of the time
+      const LD k0 = key_ld(u0, d), k1 = key_ld(u1, d);
+      if (!resolvable(k0, k1)) {
+        ++unresolved;
+        continue;
+      }
+      const bool truth = k0 < k1;
+      wrong_h += float_height_picks_first(u0, u1, d) != truth;
+      wrong_c += float_chord_picks_first(u0, u1, d) != truth;
+      wrong_d += double_picks_first(u0, u1, d) != truth;
+    }
+    const int n = pairs - unresolved;
+    std::printf("%-10.0e %-10d %-14.3g %-14.3g %-10.3g\n", g, n, n ? double(wrong_h) / n : 0.0,
+                n ? double(wrong_c) / n : 0.0, n ? double(wrong_d) / n : 0.0);
+    EXPECT_EQ(wrong_d, 0) << "g " << g;
+  }
+}
