@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
+#include <new>
+#include <sstream>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -34,6 +37,24 @@ void prepare_output(const fs::path& dir) {
   if (!f) throw BadInput("--out: directory '" + dir.string() + "' is not writable");
   std::fclose(f);
   fs::remove(probe, ec);
+}
+
+// Explicit spheres (fixed mode) hold 24 bytes per centre plus the index, one sphere per thread
+// when many small spheres run in parallel; per-drop samples take ~50 bytes. A run that cannot fit
+// in physical memory is refused up front, naming the value, instead of dying in the OOM killer.
+void check_memory(const EnsembleConfig& e) {
+  const double pages = double(::sysconf(_SC_PHYS_PAGES)), page = double(::sysconf(_SC_PAGESIZE));
+  if (!(pages > 0 && page > 0)) return;  // unknown: let the allocation decide
+  const double ram = pages * page;
+  double need = 64.0 * double(e.drops);
+  if (e.mode == Mode::fixed) need += 2.0 * 24.0 * double(e.sphere.asperities);  // centres + index, at least
+  if (need > ram) {
+    std::ostringstream os;
+    os << "--asperities " << e.sphere.asperities << " with --drops " << e.drops << " (" << to_string(e.mode)
+       << " mode) needs at least " << std::setprecision(3) << need / 1e9 << " GB, more than this machine's "
+       << ram / 1e9 << " GB";
+    throw BadInput(os.str());
+  }
 }
 
 class ProgressLine {
@@ -84,6 +105,7 @@ int main(int argc, char** argv) {
     quiet = o.quiet;
     if (scene.plots && !plotting_available())
       throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
+    check_memory(scene.ensemble);
     prepare_output(scene.out);
   } catch (const std::exception& ex) {
     std::cerr << "validate-geometry: error: " << ex.what() << "\n";
@@ -111,6 +133,12 @@ int main(int argc, char** argv) {
     for (const auto& p : report.plots) std::cout << ", " << p;
     std::cout << "\n";
     return report.rejected() ? 1 : 0;
+  } catch (const std::bad_alloc&) {
+    std::error_code ec;
+    for (const auto& p : written) fs::remove(p, ec);
+    std::cerr << "validate-geometry: error: out of memory for " << scene.ensemble.sphere.asperities << " asperities x "
+              << scene.ensemble.drops << " drops (" << to_string(scene.ensemble.mode) << " mode)\n";
+    return 2;
   } catch (const std::exception& ex) {
     std::error_code ec;
     for (const auto& p : written) fs::remove(p, ec);
