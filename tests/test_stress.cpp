@@ -361,3 +361,29 @@ TEST(Stress, FloatVersusDoubleWrongAsperityRate) {
     EXPECT_EQ(wrong_d, 0) << "g " << g;
   }
 }
+
+// Every backend is documented as safe to query from many threads at once (FCL's query object
+// is per call for that reason): concurrent answers equal the serial brute-force ones. Run under
+// ThreadSanitizer by scripts/test, where a shared mutable state would be reported.
+TEST(Stress, BackendsQueriedConcurrentlyGiveTheSerialAnswers) {
+  const auto body = make_rough_sphere({20000, 3e-3, 6.5e-7}, 21, 0);
+  const int queries = 512;
+  std::vector<Vec3> d(queries);
+  std::vector<Nearest> expect(queries);
+  for (int j = 0; j < queries; ++j) {
+    Stream s(21, Purpose::test, std::uint64_t(j));
+    d[j] = body_down(random_rotation(s));
+    expect[j] = brute_lowest(body.centres, d[j]);
+  }
+  for (Backend be : all_backends()) {
+    const auto index = make_contact_query(be, body.centres);
+    std::vector<Nearest> got(queries), batch(queries);
+#pragma omp parallel for num_threads(2) schedule(static, 1)
+    for (int j = 0; j < queries; ++j) got[j] = index->lowest(d[j]);
+#pragma omp parallel for num_threads(2) schedule(static, 1)
+    for (int j = 0; j < queries; j += 64)
+      index->lowest(std::span(d).subspan(j, 64), std::span(batch).subspan(j, 64));
+    EXPECT_EQ(got, expect) << to_string(be);
+    EXPECT_EQ(batch, expect) << to_string(be);
+  }
+}
