@@ -387,3 +387,111 @@ TEST(Stress, BackendsQueriedConcurrentlyGiveTheSerialAnswers) {
     EXPECT_EQ(batch, expect) << to_string(be);
   }
 }
+
+#ifdef VALIDATE_GEOMETRY
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliResult {
+  int status;
+  std::string out;
+};
+
+CliResult run_cli(const std::string& args) {
+  const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q --no-plots " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("asperity-stress-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+}  // namespace
+
+// Values at and beyond the supported ranges through the real binary: exit 2, the value named,
+// nothing written; values at the edges run and exit 0 or 1 (a law may reject far from the paper).
+TEST(StressCli, OutOfRangeValuesAreCleanErrors) {
+  struct Bad {
+    std::string args, mention;
+  };
+  for (const Bad& b : std::vector<Bad>{{"--threads 100000", "100000"},
+                                       {"--threads 1025", "1025"},
+                                       {"--radius 1e200 --asperity-radius 1 --speed 1", "1e+200"},
+                                       {"--radius 1e-120 --asperity-radius 1e-121", "1e-121"},
+                                       {"--speed 1e308", "1e+308"},
+                                       {"--speed 1.0000001e8", "100000010"},
+                                       {"--speed 1 --omega-x 1e308", "inf"},
+                                       {"--speed 1 --omega-y -4e10", "4e+10"},
+                                       {"--speed 1e-400", "1e-400"},
+                                       {"--asperities 4294967295 --mode fixed --drops 2", "4294967295"},
+                                       {"--drops 2147483648", "2147483648"},
+                                       {"--alpha 1e-400", "1e-400"},
+                                       {"--seed 18446744073709551616", "18446744073709551616"}}) {
+    const fs::path out = scratch("bad");
+    const CliResult r = run_cli(b.args + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << b.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(b.mention), std::string::npos) << b.args << " did not name " << b.mention << ":\n" << r.out;
+    EXPECT_FALSE(fs::exists(out / "report.json")) << b.args;
+    fs::remove_all(out);
+  }
+  for (const std::string ok : {"--asperities 1 --drops 100", "--asperities 4294967295 --drops 100",
+                                "--radius 1e6 --asperity-radius 1e-3 --drops 100",
+                                "--radius 1e-12 --asperity-radius 1e-15 --drops 100 --speed 1e-12 --omega-x 1e4",
+                                "--speed 1e8 --omega-x 3e10 --drops 100", "--speed 1e-12 --drops 100"}) {
+    const fs::path out = scratch("edge");
+    const CliResult r = run_cli(ok + " --out " + out.string());
+    EXPECT_TRUE(r.status == 0 || r.status == 1) << ok << "\n" << r.out;
+    EXPECT_TRUE(fs::exists(out / "report.json")) << ok;
+    const auto j = nlohmann::json::parse(slurp(out / "report.json"));
+    for (const auto& [name, q] : j.at("quantities").items())
+      for (const char* k : {"mean", "std"}) EXPECT_TRUE(q.at(k).is_number()) << ok << ": " << name << "." << k;
+    fs::remove_all(out);
+  }
+}
+
+// report.json byte for byte for --threads 1, --threads 2 and a repeat, except the wall-clock
+// timings_s object (removed by a regex that must match exactly once).
+TEST(StressCli, ReportJsonIdenticalForThreadsAndRepeats) {
+  for (const std::string scene : {"--preset fig4 --asperities 3000 --drops 3000",
+                                   "--mode fixed --spheres 3 --drops 3000 --asperities 5000 --backend grid"}) {
+    std::vector<std::string> texts;
+    for (const std::string threads : {"1", "2", "2"}) {
+      const fs::path out = scratch("repro" + threads);
+      const CliResult r = run_cli(scene + " --threads " + threads + " --out " + out.string());
+      ASSERT_TRUE(r.status == 0 || r.status == 1) << r.out;
+      std::string text = slurp(out / "report.json");
+      const std::regex timings("\"timings_s\": *\\{[^}]*\\}");
+      ASSERT_EQ(std::distance(std::sregex_iterator(text.begin(), text.end(), timings), std::sregex_iterator()), 1)
+          << text;
+      texts.push_back(std::regex_replace(text, timings, "\"timings_s\": {}"));
+      fs::remove_all(out);
+    }
+    EXPECT_EQ(texts[0], texts[1]) << scene;
+    EXPECT_EQ(texts[1], texts[2]) << scene;
+  }
+}
+#endif
