@@ -473,6 +473,26 @@ TEST(StressCli, OutOfRangeValuesAreCleanErrors) {
   }
 }
 
+// Every option with an empty, a NaN, an infinite, a malformed and a huge (10^4 characters) value:
+// exit 2 with the option named, nothing written.
+TEST(StressCli, EveryOptionRejectsEmptyNanInfMalformedAndHugeValues) {
+  const std::string huge(10000, '7');
+  const fs::path out = scratch("opts");
+  for (const std::string opt : {"--preset", "--asperities", "--radius", "--asperity-radius", "--drops", "--mode",
+                                "--spheres", "--seed", "--backend", "--threads", "--alpha", "--speed", "--omega-x",
+                                "--omega-y"}) {
+    for (const std::string& v : std::vector<std::string>{"''", "nan", "-inf", "1e3x", huge}) {
+      const std::string extra = opt == "--spheres" ? " --mode fixed" : opt.rfind("--omega", 0) == 0 ? " --speed 1" : "";
+      const std::string drops = opt == "--drops" ? "" : " --drops 100";
+      const CliResult r = run_cli(opt + " " + v + extra + drops + " --out " + out.string());
+      EXPECT_EQ(r.status, 2) << opt << " " << v.substr(0, 20) << "\n" << r.out.substr(0, 300);
+      EXPECT_NE(r.out.find(opt.substr(2)), std::string::npos) << opt << " " << v.substr(0, 20) << ": " << r.out.substr(0, 300);
+      EXPECT_FALSE(fs::exists(out / "report.json")) << opt;
+    }
+  }
+  fs::remove_all(out);
+}
+
 // report.json byte for byte for --threads 1, --threads 2 and a repeat, except the wall-clock
 // timings_s object (removed by a regex that must match exactly once).
 TEST(StressCli, ReportJsonIdenticalForThreadsAndRepeats) {
