@@ -179,7 +179,7 @@ TEST(Stress, ImpactsFiniteAtExtremeSpeedsSpinsAndGrazing) {
     for (double w : {0.0, 1e-3, 1.0, 1e2, 1e4})
       for (double tilt : {0.0, 1e-300, 1e-12, 1e-3, 1.0}) {  // horizontal velocity / u: grazing when large
         ImpactState s;
-        s.V = Vec3(u / std::max(tilt, 1e-300) * (tilt > 0), 0, -u);
+        s.V = Vec3(tilt > 0 ? u / tilt : 0.0, 0, -u);  // inf for the largest: skipped
         if (!s.V.allFinite()) continue;
         s.Omega = Vec3(-w, 0.5 * w, 0);  // spins the contact point upwards
         s.r = Vec3(1.7e-5, -0.9e-5, -(R + 6.5e-7));
