@@ -6,14 +6,18 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <numbers>
 #include <stdexcept>
 
 #include "asperity/impact.hpp"
 #include "asperity/orientation.hpp"
 #include "asperity/random.hpp"
+#include "format.hpp"
 
 namespace asperity {
+
+using detail::num;
 
 std::string_view to_string(Mode m) { return m == Mode::fresh ? "fresh" : "fixed"; }
 
@@ -35,18 +39,30 @@ void validate(const EnsembleConfig& c) {
       throw std::invalid_argument("drops (" + std::to_string(c.drops) + ") must be a multiple of spheres (" +
                                   std::to_string(c.spheres) + ")");
   }
-  if (c.threads < 0) throw std::invalid_argument("threads must be >= 0, got " + std::to_string(c.threads));
+  if (c.threads < 0 || c.threads > kMaxThreads)
+    throw std::invalid_argument("threads must be in [0, " + std::to_string(kMaxThreads) + "], got " +
+                                std::to_string(c.threads));
   if (c.impact.enabled) {
     const auto& x = c.impact;
     if (!std::isfinite(x.speed) || !(x.speed > 0))
       throw std::invalid_argument("impact speed must be finite and > 0 m/s, got " + std::to_string(x.speed));
+    if (x.speed > kMaxSpeed)
+      throw std::invalid_argument("impact speed must be <= " + num(kMaxSpeed) + " m/s (supported range), got " + num(x.speed));
     if (!x.omega.allFinite()) throw std::invalid_argument("impact omega must be finite");
+    const double surface = x.omega.norm() * (c.sphere.radius + c.sphere.asperity_radius);
+    if (!(surface <= kMaxSpeed))
+      throw std::invalid_argument("impact spin |omega| = " + num(x.omega.norm()) + " rad/s gives a surface speed of " +
+                                  num(surface) + " m/s; must be <= " + num(kMaxSpeed) + " m/s (supported range)");
     if (!std::isfinite(x.density) || !(x.density > 0))
       throw std::invalid_argument("density must be finite and > 0 kg/m^3, got " + std::to_string(x.density));
     if (!std::isfinite(x.beta) || !(x.beta > 0))
       throw std::invalid_argument("beta must be finite and > 0, got " + std::to_string(x.beta));
     if (!std::isfinite(x.eps_t) || x.eps_t < -1 || x.eps_t > 1)
       throw std::invalid_argument("eps_t must be in [-1, 1], got " + std::to_string(x.eps_t));
+    const double R = c.sphere.radius, mass = 4.0 / 3.0 * std::numbers::pi * R * R * R * x.density;
+    if (!std::isnormal(mass) || !std::isnormal(0.4 * mass * R * R))
+      throw std::invalid_argument("density " + num(x.density) + " kg/m^3 with radius " + num(R) +
+                                  " m gives a mass or moment of inertia outside the range of double");
   }
 }
 
@@ -113,8 +129,12 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
   std::vector<double> eps(n), wx(n), en(n);
   std::vector<std::uint8_t> hit(n);
   const std::int64_t ni = static_cast<std::int64_t>(n);
+  // An exception must not leave an OpenMP region (std::terminate): keep the one of the lowest
+  // drop, so the error is the same for any thread count, and rethrow it after the loop.
+  std::exception_ptr error;
+  std::int64_t error_drop = ni;
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < ni; ++i) {
+  for (std::int64_t i = 0; i < ni; ++i) try {
     const std::size_t k = static_cast<std::size_t>(i);
     ImpactState st;
     st.V = Vec3(0, 0, -x.speed);
@@ -126,7 +146,11 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
     const double e = (*eps_n)(-vn);
     const auto out = solve_impact_isotropic(mass, inertia, st, e, x.eps_t);
     hit[k] = 1, eps[k] = out->eps, wx[k] = out->Omega_after.x(), en[k] = e;
+  } catch (...) {
+#pragma omp critical(asperity_impact_error)
+    if (i < error_drop) error_drop = i, error = std::current_exception();
   }
+  if (error) std::rethrow_exception(error);
   // Compact in drop order: deterministic for any thread count.
   for (std::size_t k = 0; k < n; ++k) {
     if (!hit[k]) {

@@ -21,6 +21,11 @@ void validate(const SphereParams& p) {
     throw std::invalid_argument("radius must be a finite number > 0 m, got " + num(p.radius));
   if (!std::isfinite(p.asperity_radius) || p.asperity_radius <= 0)
     throw std::invalid_argument("asperity-radius must be a finite number > 0 m, got " + num(p.asperity_radius));
+  if (p.radius > kMaxLength)
+    throw std::invalid_argument("radius must be <= " + num(kMaxLength) + " m (supported range), got " + num(p.radius));
+  if (p.asperity_radius < kMinLength)
+    throw std::invalid_argument("asperity-radius must be >= " + num(kMinLength) + " m (supported range), got " +
+                                num(p.asperity_radius));
   if (p.asperity_radius >= p.radius)
     throw std::invalid_argument("asperity-radius (" + num(p.asperity_radius) +
                                 " m) must be smaller than radius (" + num(p.radius) + " m)");

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -41,8 +42,10 @@ KsResult ks_mixed(const std::vector<double>& x, const std::vector<std::uint8_t>&
   std::vector<double> u(x.size());
   const double below = law.cdf(atom) - mass;
   const std::int64_t n = static_cast<std::int64_t>(x.size());
+  // law.cdf may throw far outside a law's regime; an exception must not leave the OpenMP region.
+  std::exception_ptr error;
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < n; ++i) {
+  for (std::int64_t i = 0; i < n; ++i) try {
     const auto k = static_cast<std::size_t>(i);
     if (!at_atom.empty() && at_atom[k]) {
       Stream st(seed, Purpose::analysis, k);
@@ -50,7 +53,11 @@ KsResult ks_mixed(const std::vector<double>& x, const std::vector<std::uint8_t>&
     } else {
       u[k] = law.cdf(x[k]);
     }
+  } catch (...) {
+#pragma omp critical(asperity_ks_mixed_error)
+    if (!error) error = std::current_exception();
   }
+  if (error) std::rethrow_exception(error);
   std::sort(u.begin(), u.end());
   return ks_one_sample(u, [](double t) { return std::clamp(t, 0.0, 1.0); });
 }
@@ -79,7 +86,9 @@ ImpactScene impact_scene(const EnsembleConfig& e) {
 
 // The laws of the requested outputs only: contact laws if `contact`, impact laws if the
 // experiment has impacts (the planner turns impacts off when restitution is not requested).
-std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact) {
+// `impact_laws`: the Sec. IV laws describe every drop; when some drops did not impact, the eps
+// sample is truncated and those laws do not apply. `note` collects laws that were not tested.
+std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact, bool impact_laws, std::string& note) {
   const auto& p = e.sphere;
   const double R = p.radius;
   const auto n = p.asperities;
@@ -91,15 +100,26 @@ std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact) {
             {"r_y", {eq18_rx(n, R), rx}, {true, true}, {false, false}}};
   }
   // The Sec. IV laws assume eps_t = 1 and a horizontal spin.
-  if (e.impact.enabled && e.impact.eps_t == 1.0 && e.impact.omega.z() == 0.0) {
+  if (e.impact.enabled && !impact_laws) {
+    note = " Sec. IV laws not tested: some drops did not impact (contact point not approaching the plate), so the "
+           "eps and Omega'_x samples are truncated.";
+  } else if (e.impact.enabled && e.impact.eps_t == 1.0 && e.impact.omega.z() == 0.0) {
     ImpactScene x = impact_scene(e);
     ImpactScene physical = x;
     physical.core_contacts = true;  // explicit geometry lets the bare sphere touch: so must the law
-    const auto par = impact_law_parameters(physical);
-    sets.push_back({"eps", {eq28_printed(x), eq28_paper_route(x), eq28_corrected(physical)}, {false, false, true},
-                    {false, false, true}, par.eps_n, par.p_core});
-    sets.push_back({"omega_x_after", {eq33_printed(x), eq33_corrected(physical)}, {false, true}, {false, true},
-                    x.omega_x, par.p_core});
+    // Far outside the paper's regime (e.g. spin >> speed) a law's distribution cannot be built
+    // (Boost rejects its parameters): report that instead of failing the whole run.
+    try {
+      const auto par = impact_law_parameters(physical);
+      LawSet eps{"eps", {eq28_printed(x), eq28_paper_route(x), eq28_corrected(physical)}, {false, false, true},
+                 {false, false, true}, par.eps_n, par.p_core};
+      LawSet wx{"omega_x_after", {eq33_printed(x), eq33_corrected(physical)}, {false, true}, {false, true},
+                x.omega_x, par.p_core};
+      sets.push_back(std::move(eps));
+      sets.push_back(std::move(wx));
+    } catch (const std::exception& ex) {
+      note = std::string(" Sec. IV laws not tested: they cannot be evaluated at these parameters (") + ex.what() + ").";
+    }
   }
   return sets;
 }
@@ -192,7 +212,11 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
   }
   r.no_impacts = s.no_impacts;
 
-  for (const auto& set : laws_for(scene.ensemble, scene.contact_stats)) {
+  std::string law_note;
+  const bool impact_laws = s.no_impacts == 0 && s.eps.size() == n;
+  const auto law_sets = laws_for(scene.ensemble, scene.contact_stats, impact_laws, law_note);
+  r.ensemble_note += law_note;
+  for (const auto& set : law_sets) {
     const auto& x = column(s, set.quantity);
     if (x.empty()) continue;
     const bool all_drops = x.size() == n;
@@ -213,8 +237,16 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
                    !fixed && decisive_law, "", ""};
       if (!decisive_law) t.note = "as printed in the paper; reported for comparison, not decisive";
       const bool atom = li < set.has_atom.size() && set.has_atom[li];
-      const auto ks = atom ? ks_mixed(x, s.eps_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
-                           : ks_one_sample(all, law.cdf);
+      KsResult ks;
+      try {
+        ks = atom ? ks_mixed(x, s.eps_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
+                  : ks_one_sample(all, law.cdf);
+      } catch (const std::exception& ex) {
+        // Only the Sec. IV laws can fail here, far outside the paper's regime: say so, test the rest.
+        r.ensemble_note += " Law " + law.name + " not tested: it cannot be evaluated at these parameters (" +
+                           ex.what() + ").";
+        continue;
+      }
       if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
       t.D = ks.D, t.p = ks.p;
       if (!fixed) {
@@ -416,7 +448,9 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
   std::ostringstream sub;
   sub << "N = " << sp.asperities << ", {/Symbol r} = " << sp.asperity_radius << " m, " << to_string(scene.ensemble.mode)
       << ", n = " << s.r_xy.size();
-  for (const auto& set : laws_for(scene.ensemble, scene.contact_stats)) {
+  std::string law_note;  // the report says why a law is missing
+  for (const auto& set : laws_for(scene.ensemble, scene.contact_stats,
+                                  s.no_impacts == 0 && s.eps.size() == s.r_xy.size(), law_note)) {
     const auto& x = column(s, set.quantity);
     if (x.empty()) continue;
     HistogramFigure fig;

@@ -24,6 +24,11 @@ Mode parse_mode(std::string_view s);
 
 /// A single impact per drop (paper Sec. IV): the body falls onto a horizontal plate (n = +z) with
 /// V = (0, 0, -speed) and spin omega; the impulse is solved with the full rigid-body law.
+/// Largest supported speed [m/s], for the approach speed and the spin's surface speed |Omega|(R+a):
+/// a third of the speed of light, far beyond where a rigid impulse means anything, and small
+/// enough that every velocity, impulse and eps stays finite.
+inline constexpr double kMaxSpeed = 1e8;
+
 struct ImpactExperiment {
   bool enabled = false;
   double speed = 1.3;            ///< u = -V.n > 0 [m/s]
@@ -35,6 +40,10 @@ struct ImpactExperiment {
   friend bool operator==(const ImpactExperiment&, const ImpactExperiment&) = default;
 };
 
+/// Most OpenMP threads accepted: libgomp crashes when asked for ~10^5 threads (found by the
+/// stress suite), and more threads than any machine's cores only cost memory.
+inline constexpr int kMaxThreads = 1024;
+
 struct EnsembleConfig {
   SphereParams sphere;
   Mode mode = Mode::fresh;
@@ -42,7 +51,7 @@ struct EnsembleConfig {
   std::uint64_t spheres = 1;      ///< K (fixed mode); drops must be a multiple of K
   std::uint64_t seed = 1;
   Backend backend = Backend::grid;  ///< fixed mode only
-  int threads = 0;                  ///< 0 = OpenMP default
+  int threads = 0;                  ///< 0 = OpenMP default, at most kMaxThreads
   ImpactExperiment impact;          ///< off: contact statistics only (nothing else is computed)
 
   friend bool operator==(const EnsembleConfig&, const EnsembleConfig&) = default;

@@ -25,8 +25,13 @@ struct SphereParams {
   friend bool operator==(const SphereParams&, const SphereParams&) = default;
 };
 
+/// Supported lengths [m]: every derived quantity (R^3 x density, squared lengths and their sums in
+/// the statistics) then stays a normal double. Outside, results would overflow or underflow.
+inline constexpr double kMinLength = 1e-15;  ///< smallest asperity radius a [m]
+inline constexpr double kMaxLength = 1e6;    ///< largest central radius R [m]
+
 /// Throws std::invalid_argument naming the offending field and value if the parameters are not
-/// finite, positive, and a < R.
+/// finite, positive, a < R, and within [kMinLength, kMaxLength].
 void validate(const SphereParams& p);
 
 /// An explicit rough sphere in its body frame.

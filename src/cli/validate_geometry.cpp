@@ -1,61 +1,32 @@
 // validate-geometry: run a scene of explicit rough spheres, compare the contact statistics with
 // the paper's laws and the exact finite-N laws, print a table, write report.json and figures.
 // Exit status: 0 no law rejected, 1 a law rejected, 2 bad input or an output that cannot be written.
-#include <CLI/CLI.hpp>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
+#include <new>
+#include <sstream>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "asperity/plot.hpp"
 #include "asperity/report.hpp"
 #include "asperity/run.hpp"
 #include "asperity/scene.hpp"
-#include "asperity/scene_file.hpp"
+#include "cli/options.hpp"
 
 namespace fs = std::filesystem;
 using namespace asperity;
+using asperity::cli::BadInput;
 
 namespace {
-
-struct BadInput : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// Every number goes through here: the whole text must parse and be finite.
-double parse_real(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;  // not a number, or out of the range of double
-  }
-  if (text.empty() || used != text.size()) throw BadInput(option + ": '" + text + "' is not a number");
-  if (!std::isfinite(v)) throw BadInput(option + ": '" + text + "' must be finite");
-  return v;
-}
-
-double parse_positive(const std::string& option, const std::string& text, const char* unit = "metres") {
-  const double v = parse_real(option, text);
-  if (v <= 0) throw BadInput(option + ": '" + text + "' must be > 0 (" + unit + ")");
-  return v;
-}
-
-// Counts may be written as integers or in exact scientific notation ("1e5").
-std::uint64_t parse_count(const std::string& option, const std::string& text) {
-  const double v = parse_real(option, text);
-  if (v < 1) throw BadInput(option + ": '" + text + "' must be >= 1");
-  if (v != std::floor(v)) throw BadInput(option + ": '" + text + "' must be a whole number");
-  if (v > 9.007199254740992e15) throw BadInput(option + ": '" + text + "' is too large");
-  return static_cast<std::uint64_t>(v);
-}
 
 // Creates the directory if needed and proves it writable before any work starts.
 void prepare_output(const fs::path& dir) {
@@ -67,6 +38,24 @@ void prepare_output(const fs::path& dir) {
   if (!f) throw BadInput("--out: directory '" + dir.string() + "' is not writable");
   std::fclose(f);
   fs::remove(probe, ec);
+}
+
+// Explicit spheres (fixed mode) hold 24 bytes per centre plus the index, one sphere per thread
+// when many small spheres run in parallel; per-drop samples take ~50 bytes. A run that cannot fit
+// in physical memory is refused up front, naming the value, instead of dying in the OOM killer.
+void check_memory(const EnsembleConfig& e) {
+  const double pages = double(::sysconf(_SC_PHYS_PAGES)), page = double(::sysconf(_SC_PAGESIZE));
+  if (!(pages > 0 && page > 0)) return;  // unknown: let the allocation decide
+  const double ram = pages * page;
+  double need = 64.0 * double(e.drops);
+  if (e.mode == Mode::fixed) need += 2.0 * 24.0 * double(e.sphere.asperities);  // centres + index, at least
+  if (need > ram) {
+    std::ostringstream os;
+    os << "--asperities " << e.sphere.asperities << " with --drops " << e.drops << " (" << to_string(e.mode)
+       << " mode) needs at least " << std::setprecision(3) << need / 1e9 << " GB, more than this machine's "
+       << ram / 1e9 << " GB";
+    throw BadInput(os.str());
+  }
 }
 
 class ProgressLine {
@@ -104,93 +93,20 @@ class ProgressLine {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"validate-geometry: contact statistics of explicit rough spheres against the laws of "
-               "Gunkelmann, Montaine & Poeschel, PRE 89, 022205 (2014). Lengths in metres."};
-  std::string preset_name = "fig3", asperities, radius, asperity_radius, drops, spheres, mode, backend, seed, out;
-  int threads = 0;
-  double alpha = 0.01;
-  bool no_plots = false, quiet = false;
-  std::string scene_file;
-  auto* preset_opt = app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5");
-  app.add_option("--scene", scene_file, "scene file (TOML, see README \"Scenes\"); the options below override it")
-      ->excludes(preset_opt);
-  app.add_option("--asperities,-N", asperities, "number of asperities N (>= 1)");
-  app.add_option("--radius", radius, "central sphere radius R [m]");
-  app.add_option("--asperity-radius", asperity_radius, "asperity radius a [m], 0 < a < R");
-  app.add_option("--drops", drops, "number of drops (fixed: spheres x rotations)");
-  app.add_option("--mode", mode, "fresh (a new sphere per drop) or fixed (K spheres x M rotations)");
-  app.add_option("--spheres,-K", spheres, "number of explicit spheres K (fixed mode)");
-  app.add_option("--seed", seed, "random seed (results are identical for any thread count)");
-  app.add_option("--backend", backend, "contact query: brute, kdtree, cgal, fcl, grid (fixed mode)");
-  app.add_option("--threads", threads, "OpenMP threads (0 = all)");
-  app.add_option("--alpha", alpha, "significance level of each test, in (0,1)");
-  app.add_option("--out", out, "output directory for report.json and figures");
-  std::string speed, omega_x, omega_y;
-  app.add_option("--speed", speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
-  app.add_option("--omega-x", omega_x, "impact: spin Omega_x before [rad/s]");
-  app.add_option("--omega-y", omega_y, "impact: spin Omega_y before [rad/s]");
-  app.add_flag("--no-plots", no_plots, "do not write PNG figures");
-  app.add_flag("--quiet,-q", quiet, "print no progress");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    app.exit(e);
-    return 2;
-  }
-
   Scene scene;
+  bool quiet = false;
   try {
-    // Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
-    auto given = [&](const char* name) { return app.count(name) > 0; };
-    scene = given("--scene") ? load_scene(scene_file) : preset(preset_name);
-    auto& e = scene.ensemble;
-    if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities);
-    if (given("--radius")) e.sphere.radius = parse_positive("--radius", radius);
-    if (given("--asperity-radius")) e.sphere.asperity_radius = parse_positive("--asperity-radius", asperity_radius);
-    if (given("--drops")) e.drops = parse_count("--drops", drops);
-    if (given("--spheres")) e.spheres = parse_count("--spheres", spheres);
-    if (given("--seed")) {
-      std::size_t used = 0;
-      try {
-        e.seed = std::stoull(seed, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (seed.empty() || used != seed.size() || seed.front() == '-') throw BadInput("--seed: '" + seed + "' is not a non-negative integer");
+    const std::vector<std::string> args(argv + 1, argv + argc);
+    const cli::Options o = cli::parse_command_line(args);
+    if (o.help) {
+      std::cout << o.help_text;
+      return 0;
     }
-    if (given("--mode")) e.mode = parse_mode(mode);
-    if (given("--speed")) {
-      e.impact.enabled = true;
-      scene.restitution_stats = true;
-      e.impact.speed = parse_positive("--speed", speed, "m/s");
-    }
-    if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", omega_x);
-    if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", omega_y);
-    if ((given("--omega-x") || given("--omega-y")) && !e.impact.enabled)
-      throw BadInput("--omega-x/--omega-y need an impact: give --speed or a preset with impacts (fig4, fig5)");
-    if (given("--backend")) {
-      e.backend = parse_backend(backend);
-      scene.backend_auto = false;
-    }
-    if (threads < 0) throw BadInput("--threads: '" + std::to_string(threads) + "' must be >= 0");
-    if (given("--threads")) e.threads = threads;
-    if (!std::isfinite(alpha) || !(alpha > 0 && alpha < 1))
-      throw BadInput("--alpha: '" + std::to_string(alpha) + "' must be in (0, 1)");
-    if (given("--alpha")) scene.alpha = alpha;
-    if (no_plots) scene.plots = false;
-    if (given("--out")) {
-      if (out.empty()) throw BadInput("--out: '' is not a directory name");
-      scene.out = out;
-    }
-    if (!given("--scene") && preset_name != scene.name) scene.name = preset_name;
-    if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
-        given("--speed") || given("--omega-x") || given("--omega-y"))
-      scene.name += "+custom";
-    validate(scene);
+    scene = o.scene;
+    quiet = o.quiet;
     if (scene.plots && !plotting_available())
       throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
+    check_memory(scene.ensemble);
     prepare_output(scene.out);
   } catch (const std::exception& ex) {
     std::cerr << "validate-geometry: error: " << ex.what() << "\n";
@@ -210,6 +126,12 @@ int main(int argc, char** argv) {
     for (const auto& p : report.plots) std::cout << ", " << p;
     std::cout << "\n";
     return report.rejected() ? 1 : 0;
+  } catch (const std::bad_alloc&) {
+    std::error_code ec;
+    for (const auto& p : written) fs::remove(p, ec);
+    std::cerr << "validate-geometry: error: out of memory for " << scene.ensemble.sphere.asperities << " asperities x "
+              << scene.ensemble.drops << " drops (" << to_string(scene.ensemble.mode) << " mode)\n";
+    return 2;
   } catch (const std::exception& ex) {
     std::error_code ec;
     for (const auto& p : written) fs::remove(p, ec);
