@@ -5,7 +5,7 @@
 
 namespace asperity {
 
-std::vector<std::string> preset_names() { return {"fig3", "fig3-fixed", "fig4", "fig5"}; }
+std::vector<std::string> preset_names() { return {"fig3", "fig3-fixed", "fig4", "fig5", "fig6"}; }
 
 Scene preset(std::string_view name) {
   Scene s;
@@ -42,6 +42,13 @@ Scene preset(std::string_view name) {
     s.ensemble.impact.omega = Vec3(0.0, 0.0, 0.0);
     return s;
   }
+  if (name == "fig6") {
+    // Sec. V / Fig. 6: bounce sequences of a rough sphere, N = 1e6, a = 5e-4 mm.
+    s.name = "fig6";
+    s.ensemble.sphere = SphereParams{1000000, 3e-3, 5e-7};
+    s.bounce.enabled = true;
+    return s;
+  }
   std::string known;
   for (const auto& p : preset_names()) known += (known.empty() ? "" : ", ") + p;
   throw std::invalid_argument("unknown preset '" + std::string(name) + "' (known: " + known + ")");
@@ -52,6 +59,7 @@ void validate(const Scene& s) {
   if (!(s.alpha > 0 && s.alpha < 1))
     throw std::invalid_argument("alpha must be in (0, 1), got " + std::to_string(s.alpha));
   if (s.out.empty()) throw std::invalid_argument("out must not be empty");
+  if (s.bounce.enabled) validate(s.bounce);
 }
 
 }  // namespace asperity

@@ -108,7 +108,7 @@ int main(int argc, char** argv) {
   int threads = 0;
   double alpha = 0.01;
   bool no_plots = false, quiet = false;
-  app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5");
+  app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
   app.add_option("--asperities,-N", asperities, "number of asperities N (>= 1)");
   app.add_option("--radius", radius, "central sphere radius R [m]");
   app.add_option("--asperity-radius", asperity_radius, "asperity radius a [m], 0 < a < R");
@@ -124,6 +124,9 @@ int main(int argc, char** argv) {
   app.add_option("--speed", speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
   app.add_option("--omega-x", omega_x, "impact: spin Omega_x before [rad/s]");
   app.add_option("--omega-y", omega_y, "impact: spin Omega_y before [rad/s]");
+  std::string variants, sequences;
+  app.add_option("--variant", variants, "bounce runs (fig6): comma list of paper, paper-printed33, random-orientation, dynamic");
+  app.add_option("--sequences", sequences, "bounce runs (fig6): bounce sequences per variant");
   app.add_flag("--no-plots", no_plots, "do not write PNG figures");
   app.add_flag("--quiet,-q", quiet, "print no progress");
   try {
@@ -165,6 +168,21 @@ int main(int argc, char** argv) {
     if ((given("--omega-x") || given("--omega-y")) && !e.impact.enabled)
       throw BadInput("--omega-x/--omega-y need an impact: give --speed or a preset with impacts (fig4, fig5)");
     if (given("--backend")) e.backend = parse_backend(backend);
+    if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
+      throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
+    if (scene.bounce.enabled) {
+      if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
+      if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", sequences);
+      if (given("--variant")) {
+        scene.bounce.variants.clear();
+        std::size_t pos = 0;
+        do {
+          const std::size_t comma = variants.find(',', pos);
+          scene.bounce.variants.push_back(parse_bounce_variant(variants.substr(pos, comma - pos)));
+          pos = comma == std::string::npos ? comma : comma + 1;
+        } while (pos != std::string::npos);
+      }
+    }
     if (threads < 0) throw BadInput("--threads: '" + std::to_string(threads) + "' must be >= 0");
     e.threads = threads;
     if (!std::isfinite(alpha) || !(alpha > 0 && alpha < 1))
@@ -189,6 +207,26 @@ int main(int argc, char** argv) {
   }
 
   std::vector<fs::path> written;
+  if (scene.bounce.enabled) {  // Sec. V bouncing ball (bounce.hpp)
+    try {
+      const auto& e = scene.ensemble;
+      const auto reports = run_bounce_experiment(e.sphere, scene.bounce, e.seed, e.threads, quiet ? nullptr : &std::cerr);
+      std::vector<std::string> plots;
+      if (scene.plots) plots = write_bounce_plots(scene.out, reports);
+      for (const auto& p : plots) written.push_back(scene.out / p);
+      std::cout << format_bounce_table(reports);
+      write_file_atomic(scene.out / "report.json", bounce_to_json(scene.name, e.sphere, scene.bounce, e.seed, reports, plots));
+      std::cout << "wrote " << (scene.out / "report.json").string();
+      for (const auto& p : plots) std::cout << ", " << p;
+      std::cout << "\n";
+      return 0;
+    } catch (const std::exception& ex) {
+      std::error_code ec;
+      for (const auto& p : written) fs::remove(p, ec);
+      std::cerr << "validate-geometry: error: " << ex.what() << "\n";
+      return 2;
+    }
+  }
   try {
     using Clock = std::chrono::steady_clock;
     ProgressLine progress(!quiet);
