@@ -260,6 +260,24 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
     }
   }
   r.spin_final_mean = last ? spin_last / static_cast<double>(last) : 0.0;
+  {
+    const auto en0 = viscoelastic_pade14(b.beta);
+    double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    std::size_t np = 0;
+    for (std::size_t j = 1; j < s.eps.size(); ++j) {
+      if (s.sequence[j] != s.sequence[j - 1] || s.number[j - 1] < 2) continue;  // k-1 >= 2: both after spin-up
+      const double x = s.eps[j - 1] - (*en0)(s.speed[j - 1]), y = s.eps[j] - (*en0)(s.speed[j]);
+      sx += x, sy += y, sxx += x * x, syy += y * y, sxy += x * y, ++np;
+    }
+    r.lag1_pairs = np;
+    if (np > 2) {
+      const double n = static_cast<double>(np);
+      const double cxy = sxy / n - sx / n * sy / n, vx = sxx / n - sx / n * sx / n, vy = syy / n - sy / n * sy / n;
+      r.lag1_correlation = {cxy / std::sqrt(vx * vy), 1.0 / std::sqrt(n)};
+    } else {
+      r.lag1_correlation = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+    }
+  }
   if (r.time_n) {
     r.time_diff_mean = sum / static_cast<double>(r.time_n);
     r.time_diff_sd = std::sqrt(std::max(0.0, sum2 / static_cast<double>(r.time_n) - r.time_diff_mean * r.time_diff_mean));
@@ -306,7 +324,10 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
       try {
         g.fit = fit_asymmetric_laplace_sorted(g.sorted);
         g.fitted = true;
-        if (b.bootstrap > 0) g.gof = laplace_gof(g.sorted, g.fit, b.bootstrap, seed, index);
+        // Bootstrap work is B n: cap it at 2e7 draws (B >= 19, p resolution 0.05) for the big
+        // low-speed windows, where any misfit is decided by D >> 1/sqrt(n) anyway.
+        const std::size_t B = std::min<std::size_t>(b.bootstrap, std::max<std::size_t>(19, 20000000 / g.n));
+        if (b.bootstrap > 0) g.gof = laplace_gof(g.sorted, g.fit, B, seed, index);
         else g.gof.p = std::numeric_limits<double>::quiet_NaN(), g.gof.D = 0;
       } catch (const std::invalid_argument&) {
         g.fitted = false;  // e.g. all values equal
@@ -334,6 +355,17 @@ std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& spher
       *log << "bounce " << to_string(v) << ": " << s.sequences << " sequences, " << s.eps.size() << " impacts, run "
            << s.seconds << " s, analysis " << std::chrono::duration<double>(Clock::now() - t0).count() - s.seconds << " s\n";
   }
+  return out;
+}
+
+std::vector<BounceComparison> compare_bounce_variants(const std::vector<BounceVariantReport>& r) {
+  std::vector<BounceComparison> out;
+  for (std::size_t i = 0; i < r.size(); ++i)
+    for (std::size_t j = i + 1; j < r.size(); ++j)
+      for (const auto& ga : r[i].groups)
+        for (const auto& gb : r[j].groups)
+          if (ga.by == gb.by && ga.lo == gb.lo && ga.hi == gb.hi && ga.n >= 20 && gb.n >= 20)
+            out.push_back({r[i].variant, r[j].variant, ga.by, ga.lo, ga.hi, ks_two_sample(ga.sorted, gb.sorted)});
   return out;
 }
 
@@ -389,6 +421,10 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
                   std::string(to_string(r.variant)).c_str(), static_cast<unsigned long long>(r.sequences), r.impacts_per_sequence,
                   r.seconds, r.time_diff_mean, r.time_diff_sd, r.time_diff_max_abs, r.time_n);
     o << line;
+    std::snprintf(line, sizeof line, "%-18s lag-1 correlation of eps - eps_n(u): %.4f +- %.4f (%zu pairs); <|Omega|> before the last impact %.3f rad/s\n",
+                  std::string(to_string(r.variant)).c_str(), r.lag1_correlation.value, r.lag1_correlation.se, r.lag1_pairs,
+                  r.spin_final_mean);
+    o << line;
   }
   o << "a, c: rates of the asymmetric Laplace law (Eq. 2) left/right of the mode [1]; KS p from a parametric bootstrap.\n"
        "Speed windows fit eps - eps_n(u) (eps_n of Eq. 9 at the impact speed), impact numbers k fit eps itself.\n";
@@ -397,7 +433,7 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
 
 std::string bounce_to_json(const std::string& scene_name, const SphereParams& sphere, const BounceExperiment& b,
                            std::uint64_t seed, const std::vector<BounceVariantReport>& reports,
-                           const std::vector<std::string>& plots) {
+                           const std::vector<std::string>& plots, const std::vector<BounceComparison>& comparisons) {
   using nlohmann::json;
   auto jnum = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
   json j;
@@ -421,6 +457,8 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
     v["sequences_per_second"] = jnum(static_cast<double>(r.sequences) / r.seconds);
     v["lazy_cells_per_sequence"] = r.cells_per_sequence, v["lazy_centres_per_sequence"] = r.centres_per_sequence;
     v["spin_before_last_impact_mean_rad_s"] = r.spin_final_mean;
+    v["lag1_correlation"] = {{"value", jnum(r.lag1_correlation.value)}, {"se", jnum(r.lag1_correlation.se)}, {"pairs", r.lag1_pairs},
+                             {"quantity", "eps-eps_n(u)"}};
     v["eps_time_vs_velocity"] = {{"n", r.time_n}, {"mean", jnum(r.time_diff_mean)}, {"sd", jnum(r.time_diff_sd)},
                                  {"max_abs", jnum(r.time_diff_max_abs)}};
     json groups = json::array();
@@ -450,7 +488,12 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
     v["groups"] = std::move(groups);
     variants.push_back(std::move(v));
   }
+  json cmp = json::array();
+  for (const auto& c : comparisons)
+    cmp.push_back({{"a", std::string(to_string(c.a))}, {"b", std::string(to_string(c.b))}, {"by", c.by}, {"range", {c.lo, c.hi}},
+                   {"statistic", "KS two-sample"}, {"D", c.ks.D}, {"p", jnum(c.ks.p)}, {"n_eff", c.ks.n}});
   j["bounce"] = {{"variants", variants},
+                 {"variant_comparisons", cmp},
                  {"grouping_note", bounce_grouping_note()},
                  {"first_speed_m_s", b.speed},
                  {"stop_speed_m_s", b.stop_speed},

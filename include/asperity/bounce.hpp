@@ -56,7 +56,8 @@ struct BounceExperiment {
   double beta = 0.0467;      ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
   double eps_t = 1.0;        ///< tangential restitution (paper: 1)
   unsigned max_impacts = 100000;  ///< safety bound per sequence
-  std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap
+  std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
+                                  ///< max(19, 2e7/n): the work is B n; the count used is reported)
   /// Impact-speed windows [lo, hi] [m/s] (the unbiased grouping, see BounceReport::grouping_note).
   std::vector<std::pair<double, double>> windows{{0.9, 1.0}, {0.7, 0.8}, {0.5, 0.6}, {0.3, 0.4}, {0.1, 0.2}};
   /// Impact numbers k (1 = first impact) grouped for comparison.
@@ -131,7 +132,22 @@ struct BounceVariantReport {
   std::size_t time_n = 0;
   double time_diff_mean = 0, time_diff_sd = 0, time_diff_max_abs = 0;
   double spin_final_mean = 0;   ///< mean |Omega| before the last impact [rad/s]
+  /// Lag-1 correlation of eps - eps_n(u) between consecutive impacts of a sequence (k >= 2), and
+  /// its iid standard error 1/sqrt(pairs): how much the orientation carried between impacts
+  /// correlates consecutive contacts.
+  Estimate lag1_correlation;
+  std::size_t lag1_pairs = 0;
 };
+
+/// Two-sample KS between two variants' groups (same grouping): does the variant change the law?
+struct BounceComparison {
+  BounceVariant a, b;
+  std::string by;
+  double lo = 0, hi = 0;
+  KsResult ks;
+};
+/// For every pair of variants in `r` and every group present in both (n >= 20 each).
+std::vector<BounceComparison> compare_bounce_variants(const std::vector<BounceVariantReport>& r);
 
 /// Groups, fits (profile MLE, Fisher se) and bootstrap goodness of fit (Purpose::analysis streams
 /// keyed by seed). Groups with fewer than 20 impacts are listed without a fit.
@@ -151,7 +167,7 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& r);
 /// report.json (schema_version 1): the usual header fields plus `bounce`.
 std::string bounce_to_json(const std::string& scene_name, const SphereParams& sphere, const BounceExperiment& b,
                            std::uint64_t seed, const std::vector<BounceVariantReport>& r,
-                           const std::vector<std::string>& plots);
+                           const std::vector<std::string>& plots, const std::vector<BounceComparison>& comparisons = {});
 
 /// Fig. 6 per variant: log-density histograms of eps - m (fitted mode) per speed window with the
 /// fitted laws; returns the file names written into `dir`.

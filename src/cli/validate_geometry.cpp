@@ -215,7 +215,12 @@ int main(int argc, char** argv) {
       if (scene.plots) plots = write_bounce_plots(scene.out, reports);
       for (const auto& p : plots) written.push_back(scene.out / p);
       std::cout << format_bounce_table(reports);
-      write_file_atomic(scene.out / "report.json", bounce_to_json(scene.name, e.sphere, scene.bounce, e.seed, reports, plots));
+      const auto comparisons = compare_bounce_variants(reports);
+      for (const auto& c : comparisons)
+        std::cout << "KS " << to_string(c.a) << " vs " << to_string(c.b) << ", " << c.by << " [" << c.lo << ", " << c.hi
+                  << "]: D = " << c.ks.D << ", p = " << c.ks.p << "\n";
+      write_file_atomic(scene.out / "report.json",
+                        bounce_to_json(scene.name, e.sphere, scene.bounce, e.seed, reports, plots, comparisons));
       std::cout << "wrote " << (scene.out / "report.json").string();
       for (const auto& p : plots) std::cout << ", " << p;
       std::cout << "\n";
