@@ -97,6 +97,25 @@ struct Physics {
   double beta;
 };
 
+// The lowest asperity for a down direction d_new that is delta = |d_new - d_old| away from a
+// direction already queried. Keys are squared chords, so every other centre keeps
+// sqrt(key) >= sqrt(K2) - delta and the winner sqrt(key) <= sqrt(K1) + delta: when those bounds do
+// not cross, the winner is unchanged and only its key is recomputed (exactly as a query would);
+// otherwise a full query. Saves the second query of the landing-time iteration, where d moves by
+// ~1e-9. runner_up_key then becomes a lower bound on every other key (so chained calls stay
+// exact), and runner_up is stale: neither is used by the bounce dynamics.
+LazyNearest requery(LazySphere& S, const LazyNearest& old, const Vec3& d_old, const Vec3& d_new) {
+  const double delta = (d_new - d_old).norm();
+  const double k1 = std::sqrt(old.nearest.key) + delta, k2 = std::sqrt(old.nearest.runner_up_key) - delta;
+  if (k2 > 0 && k1 * k1 * (1 + 1e-9) < k2 * k2) {
+    LazyNearest r = old;
+    r.nearest.key = contact_key(old.u, d_new);
+    r.nearest.runner_up_key = k2 * k2 / (1 + 1e-9);  // a lower bound for every other centre at d_new
+    return r;
+  }
+  return S.lowest(d_new);
+}
+
 double depth(const LazyNearest& L, const Physics& p) { return std::max(p.R, p.R * (1.0 - 0.5 * L.nearest.key) + p.a); }
 
 void run_explicit(std::uint64_t i, BounceVariant v, const BounceExperiment& b, const Physics& p, std::uint64_t seed,
@@ -136,9 +155,12 @@ void run_explicit(std::uint64_t i, BounceVariant v, const BounceExperiment& b, c
     } else {
       // Fixed point t = flight(D(q(t))): D moves by nanometres, so 2-3 steps reach equality.
       t = ballistic_flight(h0, vz, h0, p.g).time;
+      Vec3 d_prev;
       for (int it = 0; it < 8; ++it) {
         q_land = advance_rotation(q, W, t);
-        L = S.lowest(body_down(q_land));
+        const Vec3 d = body_down(q_land);
+        L = it == 0 ? S.lowest(d) : requery(S, L, d_prev, d);
+        d_prev = d;
         const Flight f = ballistic_flight(h0, vz, depth(L, p), p.g);
         const double tn = f.time, vn_land = f.landing_vz;
         const bool same = tn == t;
