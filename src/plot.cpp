@@ -324,4 +324,31 @@ void write_histogram_png(const fs::path& png, const HistogramFigure& fig) {
     throw std::runtime_error("write_histogram_png: cannot rename onto " + png.string() + ": " + ec.message());
 }
 
+void write_gnuplot_png(const fs::path& png, const std::function<std::string(const fs::path& out)>& script_for) {
+  if (png.empty() || !png.has_filename()) throw std::invalid_argument("write_gnuplot_png: output path has no file name");
+  const std::string suffix = random_suffix();
+  Cleanup cleanup;
+  std::error_code ec;
+  const fs::path tmp_root = fs::temp_directory_path(ec);
+  if (ec) throw std::runtime_error("write_gnuplot_png: no temporary directory: " + ec.message());
+  const fs::path work = tmp_root / ("asperity-plot-gp-" + suffix);
+  if (!fs::create_directory(work, ec) || ec) throw std::runtime_error("write_gnuplot_png: cannot create " + work.string());
+  cleanup.paths.push_back(work);
+  const fs::path out = png.parent_path() / (png.filename().string() + "." + suffix + ".tmp");
+  cleanup.paths.push_back(out);
+  const fs::path script = work / "figure.gp", err = work / "gnuplot.err";
+  {
+    std::ofstream f(script, std::ios::binary);
+    f << script_for(out);
+    f.close();
+    if (!f) throw std::runtime_error("write_gnuplot_png: cannot write " + script.string());
+  }
+  const bool ok = run_ok("gnuplot " + shell_quote(script.string()) + " </dev/null >/dev/null 2>" + shell_quote(err.string()));
+  const std::string messages = read_file_text(err);
+  if (!ok || !fs::is_regular_file(out, ec) || fs::file_size(out, ec) == 0)
+    throw std::runtime_error("write_gnuplot_png: gnuplot failed writing " + png.string() + (messages.empty() ? "" : ":\n" + messages));
+  fs::rename(out, png, ec);
+  if (ec) throw std::runtime_error("write_gnuplot_png: cannot rename onto " + png.string() + ": " + ec.message());
+}
+
 }  // namespace asperity

@@ -34,6 +34,7 @@ void validate(const Scene& s) {
   if (s.report.empty() || s.report.find('/') != std::string::npos || s.report == "." || s.report == "..")
     throw std::invalid_argument("report must be a file name inside out, got '" + s.report + "'");
   if (s.name.empty()) throw std::invalid_argument("name must not be empty");
+  if (s.bounce.enabled) validate(s.bounce);
 }
 
 }  // namespace asperity

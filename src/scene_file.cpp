@@ -367,8 +367,33 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   bool impacts = false;
   if (auto ex = top.table("experiment")) {
     const auto kind = ex->choice("kind", {"contact", "impact", "bounce"}).value_or("contact");
-    if (kind == "bounce") ex->unsupported("kind", "bounce sequences are not in the engine yet");
     impacts = kind == "impact";
+    if (kind == "bounce") {
+      // Sec. V: sequences of impacts from `speed` down to `stop_speed`, Omega = 0 at the start.
+      s.bounce.enabled = true;
+      if (auto u = ex->positive("speed", "m/s")) s.bounce.speed = *u;
+      if (auto u = ex->positive("stop_speed", "m/s")) s.bounce.stop_speed = *u;
+      if (auto g = ex->positive("gravity", "m/s^2")) s.bounce.gravity = *g;
+      if (auto n = ex->count("sequences", 1, std::uint64_t{1} << 31)) s.bounce.sequences = *n;
+      if (auto v = ex->text("variants")) {
+        s.bounce.variants.clear();
+        std::size_t pos = 0;
+        try {
+          do {
+            const std::size_t comma = v->find(',', pos);
+            s.bounce.variants.push_back(parse_bounce_variant(v->substr(pos, comma - pos)));
+            pos = comma == std::string::npos ? comma : comma + 1;
+          } while (pos != std::string::npos);
+        } catch (const std::invalid_argument& err) {
+          ex->bad("variants", err.what());
+        }
+      }
+      if (!(s.bounce.stop_speed < s.bounce.speed))
+        ex->bad("stop_speed", "must be below speed = " + num(s.bounce.speed) + " m/s, got " + num(s.bounce.stop_speed));
+    } else {
+      for (const char* k : {"speed", "stop_speed", "gravity", "sequences", "variants"})
+        if (ex->has(k)) ex->bad(k, "only for kind = \"bounce\"");
+    }
     if (impacts) {
       const auto V = ex->vec3("V", "m/s");
       const auto Omega = ex->vec3("Omega", "rad/s");
@@ -386,15 +411,19 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     ex->finish();
   }
   impact.enabled = impacts;
+  if (s.bounce.enabled) {  // the material applies to every impact of a sequence
+    s.bounce.density = impact.density, s.bounce.beta = impact.beta, s.bounce.eps_t = impact.eps_t;
+  }
 
   // [outputs]
   if (auto out = top.table("outputs")) {
     if (auto c = out->boolean("contact")) s.contact_stats = *c;
     if (auto r = out->boolean("restitution")) {
-      if (*r && !impacts) out->bad("restitution", "true needs experiment.kind = \"impact\"");
+      if (*r && !impacts && !s.bounce.enabled)
+        out->bad("restitution", "true needs experiment.kind = \"impact\" or \"bounce\"");
       s.restitution_stats = *r;
     }
-    if (!s.contact_stats && !(impacts && s.restitution_stats))
+    if (!s.bounce.enabled && !s.contact_stats && !(impacts && s.restitution_stats))
       out->bad("contact", "nothing to compute: request contact = true, or restitution = true with an impact experiment");
     if (auto p = out->boolean("plots")) s.plots = *p;
     if (auto a = out->real("alpha")) {
@@ -537,7 +566,13 @@ std::string to_toml(const Scene& s) {
     os << e.seed;
   os << "\nbackend = \"" << (s.backend_auto ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
      << e.threads << "\n\n";
-  if (x.enabled) {
+  if (s.bounce.enabled) {
+    const auto& b = s.bounce;
+    os << "[experiment]\nkind = \"bounce\"\nspeed = " << num(b.speed) << "\nstop_speed = " << num(b.stop_speed)
+       << "\ngravity = " << num(b.gravity) << "\nsequences = " << b.sequences << "\nvariants = \"";
+    for (std::size_t i = 0; i < b.variants.size(); ++i) os << (i ? "," : "") << to_string(b.variants[i]);
+    os << "\"\n\n";
+  } else if (x.enabled) {
     os << "[experiment]\nkind = \"impact\"\nV = [0.0, 0.0, " << num(-x.speed) << "]\nOmega = [" << num(x.omega.x())
        << ", " << num(x.omega.y()) << ", " << num(x.omega.z()) << "]\n\n";
   } else {

@@ -191,7 +191,7 @@ TEST(CliScene, BadScenesExitWith2NamingTheKeyAndWriteNothing) {
       {"format = 1\n[body]\nradius = nan\n", "body.radius"},
       {"format = 1\n[ensemble]\ndrops = -3\n", "ensemble.drops"},
       {"format = 1\n[outputs]\ncolour = 1\n", "outputs.colour"},
-      {"format = 1\n[experiment]\nkind = \"bounce\"\n", "not supported yet: experiment.kind"},
+      {"format = 1\n[experiment]\nkind = \"bounce\"\nstop_speed = 2.0\n", "experiment.stop_speed"},
       {"format = 1\n[asperities]\nradius = { distribution = \"lognormal\", median = 1e-7, sigma = 0.1 }\n",
        "not supported yet: asperities.radius.distribution"},
       {"format = 1\nname = \"\"\n", "name"},

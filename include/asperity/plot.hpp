@@ -2,6 +2,7 @@
 // Publication-style PNG figures of measured histograms against analytic laws, drawn by gnuplot
 // (pngcairo). A figure is a value; writing it is one call.
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,5 +34,11 @@ bool plotting_available();
 /// file and renames, so a failure never leaves a partial PNG. Throws std::runtime_error with
 /// gnuplot's message on failure.
 void write_histogram_png(const std::filesystem::path& png, const HistogramFigure& fig);
+
+/// Runs a caller-built gnuplot script that renders to the path it is given (a temporary beside
+/// `png`), then renames the result onto `png`: like write_histogram_png, a failure leaves no
+/// partial file. Throws std::runtime_error with gnuplot's message on failure.
+void write_gnuplot_png(const std::filesystem::path& png,
+                       const std::function<std::string(const std::filesystem::path& out)>& script);
 
 }  // namespace asperity

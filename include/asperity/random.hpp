@@ -15,6 +15,8 @@ enum class Purpose : std::uint32_t {
   orientation = 2,  ///< a random rotation of a drop
   fresh = 3,        ///< the cap of a fresh random sphere
   analysis = 4,     ///< randomisation inside statistical tests (e.g. the PIT at an atom)
+  lazy_sphere = 5,  ///< counts and centres of the cells of one lazy sphere (lazy_sphere.hpp)
+  bounce = 6,       ///< per-sequence draws of a bounce sequence (initial orientation, paper laws)
   test = 99,        ///< reserved for tests
 };
 

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "asperity/bounce.hpp"
 #include "asperity/ensemble.hpp"
 
 namespace asperity {
@@ -28,6 +29,8 @@ struct Scene {
   std::string report = "report.json";  ///< report file name inside `out`
 
   friend bool operator==(const Scene&, const Scene&) = default;
+
+  BounceExperiment bounce;    ///< Sec. V bouncing ball (fig6); when enabled, the run is a bounce run
 };
 
 /// Names of the built-in presets (the files scenes/NAME.toml, embedded in the library).
@@ -40,6 +43,8 @@ std::string_view preset_text(std::string_view name);
 /// fig3-fixed: the same from 100 explicit spheres x 1e4 rotations (grid backend).
 /// fig4: Fig. 3's sphere dropped at V.n = 1.3 m/s with Omega_x = 0.2 rad/s: eps and Omega'_x.
 /// fig5: Omega = 0, V.n = 1 m/s, a = R x 1e-4: Omega'_x.
+/// fig6: Sec. V bouncing ball, N = 1e6, R = 3 mm, a = 5e-7 m, V_z = 1 m/s, Omega = 0, until
+///       V_z < 0.1 m/s, 1e5 sequences per variant (paper, random-orientation, dynamic).
 Scene preset(std::string_view name);
 
 /// Throws std::invalid_argument naming the offending field and value.

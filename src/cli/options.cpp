@@ -51,7 +51,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   std::string threads, alpha;
   bool no_plots = false, quiet = false;
   std::string scene_file;
-  auto* preset_opt = app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5");
+  auto* preset_opt = app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
   app.add_option("--scene", scene_file, "scene file (TOML, see README \"Scenes\"); the options below override it")
       ->excludes(preset_opt);
   app.add_option("--asperities,-N", asperities, "number of asperities N (>= 1)");
@@ -69,6 +69,9 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   app.add_option("--speed", speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
   app.add_option("--omega-x", omega_x, "impact: spin Omega_x before [rad/s]");
   app.add_option("--omega-y", omega_y, "impact: spin Omega_y before [rad/s]");
+  std::string variants, sequences;
+  app.add_option("--variant", variants, "bounce runs (fig6): comma list of paper, paper-printed33, random-orientation, dynamic");
+  app.add_option("--sequences", sequences, "bounce runs (fig6): bounce sequences per variant");
   app.add_flag("--no-plots", no_plots, "do not write PNG figures");
   app.add_flag("--quiet,-q", quiet, "print no progress");
 
@@ -117,6 +120,21 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     if (given("--backend")) {
       e.backend = parse_backend(backend);
       scene.backend_auto = false;
+    }
+    if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
+      throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
+    if (scene.bounce.enabled) {
+      if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
+      if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", sequences);
+      if (given("--variant")) {
+        scene.bounce.variants.clear();
+        std::size_t pos = 0;
+        do {
+          const std::size_t comma = variants.find(',', pos);
+          scene.bounce.variants.push_back(parse_bounce_variant(variants.substr(pos, comma - pos)));
+          pos = comma == std::string::npos ? comma : comma + 1;
+        } while (pos != std::string::npos);
+      }
     }
     if (given("--threads")) {
       const std::uint64_t t = parse_count("--threads", threads, 0);
