@@ -239,13 +239,24 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   if (auto body = top.table("body")) {
     const auto kind = body->choice("kind", {"sphere", "mesh"}).value_or("sphere");
     if (kind == "mesh") {
-      // Checked so that a typo is reported before the missing feature.
-      body->text("mesh");
-      body->positive("scale", "(factor)");
-      body->unsupported("kind", "bodies from meshes/ are not in the engine yet; use \"sphere\"");
+      MeshBodyScene m;
+      const auto file = body->text("mesh");
+      if (!file) body->missing("mesh", "a mesh file (OFF/PLY/STL/OBJ), e.g. mesh = \"../meshes/ellipsoid.off\"");
+      m.file = *file;
+      if (auto sc = body->positive("scale", "(mesh units -> m)")) m.scale = *sc;
+      if (auto sm = body->reals("smooth")) {
+        if (sm->size() != 3 && sm->size() != 4)
+          body->bad("smooth", "expected [a, b, c] or [a, b, c, m] [m], got " + std::to_string(sm->size()) + " numbers");
+        for (std::size_t i = 0; i < sm->size(); ++i)
+          if (!((*sm)[i] > 0)) body->bad("smooth", "element " + std::to_string(i) + " must be > 0, got " + num((*sm)[i]));
+        m.smooth = *sm;
+      }
+      if (body->has("radius")) body->bad("radius", "only for kind = \"sphere\" (a mesh body's size is the mesh x scale)");
+      s.mesh = std::move(m);
+    } else {
+      for (const char* k : {"mesh", "scale", "smooth"})
+        if (body->has(k)) body->bad(k, "only for kind = \"mesh\"");
     }
-    for (const char* k : {"mesh", "scale"})
-      if (body->has(k)) body->bad(k, "only for kind = \"mesh\"");
     if (auto r = body->positive("radius", "m")) R = *r;
     body->finish();
   }
@@ -281,6 +292,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     const auto n = asp->count("count", 1, kMaxAsperities);
     const auto eta = asp->positive("areal_density", "per m^2");
     if (n && eta) asp->bad("areal_density", "give either count or areal_density, not both");
+    if (eta && s.mesh) asp->bad("areal_density", "a mesh body needs count (N per body), got areal_density = " + num(*eta));
     if (n) s.ensemble.sphere.asperities = *n;
     if (eta) {
       const double count = std::round(*eta * 4.0 * std::numbers::pi * R * R);
@@ -295,12 +307,16 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
       if (*dist == "fixed") {
         const auto a = rad->positive("value", "m");
         if (!a) rad->missing("value", "the asperity radius a [m]");
-        if (*a >= R) rad->bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
+        if (!s.mesh && *a >= R) rad->bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
         s.ensemble.sphere.asperity_radius = *a;
       } else if (*dist == "lognormal") {
-        rad->positive("median", "m");
-        rad->positive("sigma", "(log-space)");
-        rad->unsupported("distribution", "the engine has equal asperity radii only; use \"fixed\"");
+        const auto median = rad->positive("median", "m");
+        if (!median) rad->missing("median", "the median asperity radius exp(mu) [m]");
+        const auto sigma = rad->real("sigma");
+        if (!sigma) rad->missing("sigma", "the standard deviation of ln(radius), e.g. 0.3");
+        if (*sigma < 0) rad->bad("sigma", "must be >= 0, got " + num(*sigma));
+        if (!s.mesh && *median >= R) rad->bad("median", num(*median) + " m must be smaller than body.radius = " + num(R) + " m");
+        s.radii = RadiiScene{RadiusDistribution::lognormal(*median, *sigma)};
       } else {
         const auto radii = rad->reals("radii");
         const auto fractions = rad->reals("fractions");
@@ -315,16 +331,21 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
           }
           if (std::abs(sum - 1.0) > 1e-9) rad->bad("fractions", "must sum to 1, got " + num(sum));
         }
-        if (radii && fractions && radii->size() != fractions->size())
+        if (!radii) rad->missing("radii", "the level radii [m], e.g. [1.3e-6, 6.5e-7]");
+        if (!fractions) rad->missing("fractions", "one probability per radius, summing to 1, e.g. [0.2, 0.8]");
+        if (radii->size() != fractions->size())
           rad->bad("fractions", "needs one fraction per radius (" + std::to_string(radii->size()) + "), got " +
                                     std::to_string(fractions->size()));
-        rad->unsupported("distribution", "the engine has equal asperity radii only; use \"fixed\"");
+        if (!s.mesh)
+          for (double r : *radii)
+            if (r >= R) rad->bad("radii", num(r) + " m must be smaller than body.radius = " + num(R) + " m");
+        s.radii = RadiiScene{RadiusDistribution::discrete(*radii, *fractions)};
       }
       rad->finish();
     }
     asp->finish();
   }
-  if (s.ensemble.sphere.asperity_radius >= R)
+  if (!s.mesh && s.ensemble.sphere.asperity_radius >= R)
     top.fail(nullptr, "body.radius",
              "body.radius: " + num(R) + " m must exceed the asperity radius " + num(s.ensemble.sphere.asperity_radius) + " m");
 
@@ -362,6 +383,38 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     if (auto t = ens->count("threads", 0, 4096)) e.threads = static_cast<int>(*t);
     ens->finish();
   }
+
+  // Mesh bodies and unequal radii are runs of body_experiments.hpp: explicit bodies with the exact
+  // support tree, so the ensemble keys that choose a contact backend or a mode do not apply.
+  if (s.mesh && e.mode != Mode::fixed)
+    top.fail(nullptr, "ensemble.mode",
+             "ensemble.mode: a mesh body needs mode = \"fixed\" (ensemble.spheres explicit bodies x rotations), got \"" +
+                 std::string(to_string(e.mode)) + "\"");
+  if (s.mesh && s.ensemble.drops % s.ensemble.spheres != 0)
+    top.fail(nullptr, "ensemble.drops", "ensemble.drops: must be a multiple of ensemble.spheres");
+  if (s.radii && !s.mesh && e.mode != Mode::fresh)
+    top.fail(nullptr, "ensemble.mode",
+             "ensemble.mode: unequal asperity radii on a sphere draw fresh spheres (mode = \"fresh\") and screen "
+             "[screening] bodies explicit ones, got \"" + std::string(to_string(e.mode)) + "\"");
+  if ((s.mesh || s.radii) && !s.backend_auto)
+    top.fail(nullptr, "ensemble.backend",
+             "ensemble.backend: mesh bodies and unequal asperity radii use the exact support tree; only \"auto\", got \"" +
+                 std::string(to_string(e.backend)) + "\"");
+
+  // [screening]: unequal radii on a sphere only.
+  if (auto scr = top.table("screening")) {
+    if (!s.radii || s.mesh)
+      scr->fail(nullptr, "screening", "screening: only for unequal asperity radii (asperities.radius distribution "
+                                      "\"levels\" or \"lognormal\") on a sphere body");
+    if (auto b = scr->count("bodies", 1, 1u << 20)) s.radii->screen_bodies = *b;
+    if (auto d = scr->count("directions", 1, kMaxDrops)) s.radii->screen_directions = *d;
+    scr->finish();
+  }
+  if (s.radii && !s.mesh && s.radii->radii.kind == RadiusDistribution::Kind::lognormal &&
+      e.drops % s.radii->screen_bodies != 0)
+    top.fail(nullptr, "ensemble.drops",
+             "ensemble.drops: " + std::to_string(e.drops) + " must be a multiple of screening.bodies = " +
+                 std::to_string(s.radii->screen_bodies) + " (lognormal radii: r_x comes from rotations of the screened bodies)");
 
   // [experiment]
   bool impacts = false;
@@ -411,6 +464,11 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     ex->finish();
   }
   impact.enabled = impacts;
+  if (s.mesh && !impacts)
+    top.fail(nullptr, "experiment.kind", "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega)");
+  if (s.radii && !s.mesh && (impacts || s.bounce.enabled))
+    top.fail(nullptr, "experiment.kind",
+             "experiment.kind: unequal asperity radii on a sphere are analysed as contacts only; use kind = \"contact\"");
   if (s.bounce.enabled) {  // the material applies to every impact of a sequence
     s.bounce.density = impact.density, s.bounce.beta = impact.beta, s.bounce.eps_t = impact.eps_t;
   }
@@ -434,8 +492,18 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     if (auto r = out->text("report")) {
       if (r->find('/') != std::string::npos || *r == "." || *r == "..")
         out->bad("report", "must be a file name inside outputs.dir, got " + quote(*r));
+      if ((s.mesh || s.radii) && *r != "report.json")
+        out->bad("report", "mesh bodies and unequal radii always write report.json, got " + quote(*r));
       s.report = *r;
     }
+    if (auto p = out->text("export_ply")) {
+      if (!s.mesh) out->bad("export_ply", "only for body.kind = \"mesh\"");
+      if (p->find('/') != std::string::npos || *p == "." || *p == "..")
+        out->bad("export_ply", "must be a file name inside outputs.dir, got " + quote(*p));
+      s.mesh->export_ply = *p;
+    }
+    if (s.mesh && !(s.contact_stats && s.restitution_stats))
+      out->bad(s.contact_stats ? "restitution" : "contact", "a mesh body's run always analyses contacts and restitution");
     out->finish();
   }
   top.finish();
@@ -517,6 +585,32 @@ std::size_t bad_table_header(std::string_view t) {
   return 0;
 }
 
+// body.mesh relative to the scene file's directory, then to the meshes/ of the source tree and of
+// the installation (by the path as written, then by its file name).
+std::filesystem::path resolve_mesh(const std::filesystem::path& mesh, const std::filesystem::path& scene_file,
+                                   const std::filesystem::path& scene_dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<fs::path> tried;
+  if (mesh.is_absolute()) {
+    tried.push_back(mesh);
+  } else {
+    tried.push_back(scene_dir.empty() ? mesh : scene_dir / mesh);
+    for (const char* dir_name : {ASPERITY_SOURCE_MESHES_DIR, ASPERITY_INSTALL_MESHES_DIR}) {
+      const fs::path dir(dir_name);
+      tried.push_back(dir / mesh);
+      tried.push_back(dir / mesh.filename());
+    }
+  }
+  for (const auto& p : tried)
+    if (fs::is_regular_file(p, ec)) return p.lexically_normal();
+  std::string where;
+  for (const auto& p : tried) where += (where.empty() ? "" : ", ") + p.string();
+  throw SceneError(scene_file.string() + ": body.mesh: mesh file " + quote(mesh.string()) + " not found (looked for " +
+                       where + ")",
+                   "body.mesh");
+}
+
 }  // namespace
 
 Scene parse_scene(std::string_view toml_text, std::string_view origin) {
@@ -542,7 +636,9 @@ Scene load_scene(const std::filesystem::path& file) {
   std::ostringstream text;
   text << f.rdbuf();
   if (!f && !f.eof()) throw SceneError("cannot read scene file '" + file.string() + "'", "");
-  return parse_scene(text.str(), file.string());
+  Scene s = parse_scene(text.str(), file.string());
+  if (s.mesh) s.mesh->file = resolve_mesh(s.mesh->file, file, file.parent_path());
+  return s;
 }
 
 std::string to_toml(const Scene& s) {
@@ -552,11 +648,35 @@ std::string to_toml(const Scene& s) {
   os << "# asperity scene (README \"Scenes\")\n";
   os << "format = " << kSceneFormatVersion << "\n";
   os << "name = " << quote(s.name) << "\n\n";
-  os << "[body]\nkind = \"sphere\"\nradius = " << num(e.sphere.radius) << "\n\n";
+  if (s.mesh) {
+    os << "[body]\nkind = \"mesh\"\nmesh = " << quote(s.mesh->file.string()) << "\nscale = " << num(s.mesh->scale) << "\n";
+    if (!s.mesh->smooth.empty()) {
+      os << "smooth = [";
+      for (std::size_t i = 0; i < s.mesh->smooth.size(); ++i) os << (i ? ", " : "") << num(s.mesh->smooth[i]);
+      os << "]\n";
+    }
+    os << "\n";
+  } else {
+    os << "[body]\nkind = \"sphere\"\nradius = " << num(e.sphere.radius) << "\n\n";
+  }
   os << "[material]\ndensity = " << num(x.density) << "\neps_t = " << num(x.eps_t)
      << "\nrestitution = { model = \"viscoelastic\", beta = " << num(x.beta) << " }\n\n";
-  os << "[asperities]\ncount = " << e.sphere.asperities << "\nradius = { distribution = \"fixed\", value = "
-     << num(e.sphere.asperity_radius) << " }\n\n";
+  os << "[asperities]\ncount = " << e.sphere.asperities << "\n";
+  if (!s.radii) {
+    os << "radius = { distribution = \"fixed\", value = " << num(e.sphere.asperity_radius) << " }\n\n";
+  } else if (const auto& d = s.radii->radii; d.kind == RadiusDistribution::Kind::lognormal) {
+    os << "radius = { distribution = \"lognormal\", median = " << num(d.median) << ", sigma = " << num(d.sigma) << " }\n\n";
+  } else {
+    auto list = [](const std::vector<double>& v) {
+      std::string t = "[";
+      for (std::size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + num(v[i]);
+      return t + "]";
+    };
+    os << "radius = { distribution = \"levels\", radii = " << list(d.levels) << ", fractions = " << list(d.fractions)
+       << " }\n\n";
+  }
+  if (s.radii && !s.mesh)
+    os << "[screening]\nbodies = " << s.radii->screen_bodies << "\ndirections = " << s.radii->screen_directions << "\n\n";
   os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\n";
   if (e.mode == Mode::fixed) os << "spheres = " << e.spheres << "\n";  // fresh mode has no explicit spheres
   os << "seed = ";
@@ -582,6 +702,7 @@ std::string to_toml(const Scene& s) {
   if (x.enabled || !s.restitution_stats) os << "restitution = " << (s.restitution_stats ? "true" : "false") << "\n";
   os << "plots = " << (s.plots ? "true" : "false") << "\nalpha = " << num(s.alpha) << "\ndir = " << quote(s.out.string())
      << "\nreport = " << quote(s.report) << "\n";
+  if (s.mesh && !s.mesh->export_ply.empty()) os << "export_ply = " << quote(s.mesh->export_ply) << "\n";
   return os.str();
 }
 

@@ -192,8 +192,8 @@ TEST(CliScene, BadScenesExitWith2NamingTheKeyAndWriteNothing) {
       {"format = 1\n[ensemble]\ndrops = -3\n", "ensemble.drops"},
       {"format = 1\n[outputs]\ncolour = 1\n", "outputs.colour"},
       {"format = 1\n[experiment]\nkind = \"bounce\"\nstop_speed = 2.0\n", "experiment.stop_speed"},
-      {"format = 1\n[asperities]\nradius = { distribution = \"lognormal\", median = 1e-7, sigma = 0.1 }\n",
-       "not supported yet: asperities.radius.distribution"},
+      {"format = 1\n[material]\nrestitution = { model = \"constant\", value = 0.9 }\n",
+       "not supported yet: material.restitution.model"},
       {"format = 1\nname = \"\"\n", "name"},
       {"[body\n", "TOML syntax error"},
   };
@@ -216,3 +216,57 @@ TEST(CliScene, BadScenesExitWith2NamingTheKeyAndWriteNothing) {
 }
 
 }  // namespace
+
+// Scenes beyond the paper: unequal asperity radii and a rough mesh body run their experiments
+// (body_experiments.hpp) and write report.json, report.txt (and the PLY) into outputs.dir.
+TEST(CliScene, LevelRadiiSceneRunsTheRadiiExperiment) {
+  const fs::path out = fresh_dir("levels");
+  const fs::path scene = write_scene("levels", "format = 1\nname = \"lv\"\n[asperities]\ncount = 2000\n"
+                                               "radius = { distribution = \"levels\", radii = [1.3e-6, 6.5e-7], "
+                                               "fractions = [0.2, 0.8] }\n[screening]\nbodies = 2\ndirections = 1000\n"
+                                               "[ensemble]\ndrops = 3000\nseed = 3\n[outputs]\nplots = false\n"
+                                               "dir = \"" + out.string() + "\"\n");
+  const CliRun r = run("--scene " + scene.string());
+  ASSERT_EQ(r.status, 0) << r.out;  // the exact level law is accepted (fixed seed)
+  const auto j = read_report(out / "report.json");
+  EXPECT_EQ(j.at("experiment"), "unequal-radii") << j.dump(1);
+  EXPECT_EQ(j.at("asperities"), 2000);
+  EXPECT_EQ(j.at("drops"), 3000);
+  bool exact = false;
+  for (const auto& t : j.at("tests")) exact |= t.at("note").get<std::string>().rfind("exact", 0) == 0;
+  EXPECT_TRUE(exact) << j.dump(1);
+  EXPECT_TRUE(fs::exists(out / "report.txt"));
+  fs::remove_all(out);
+  fs::remove(scene);
+}
+
+TEST(CliScene, MeshSceneRunsMeshImpactsAndExportsPly) {
+  const fs::path out = fresh_dir("mesh");
+  const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
+  const fs::path scene = write_scene("mesh", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
+                                                 "\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[asperities]\ncount = 2000\n"
+                                                 "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 200\n"
+                                                 "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n"
+                                                 "[outputs]\nplots = false\nexport_ply = \"m.ply\"\n"
+                                                 "dir = \"" + out.string() + "\"\n");
+  const CliRun r = run("--scene " + scene.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = read_report(out / "report.json");
+  EXPECT_EQ(j.at("experiment"), "mesh-impacts") << j.dump(1);
+  EXPECT_EQ(j.at("samples"), 200);
+  EXPECT_TRUE(fs::exists(out / "report.txt"));
+  EXPECT_GT(fs::file_size(out / "m.ply"), 1000u);
+  fs::remove_all(out);
+  // A mesh file that does not exist: exit 2 naming the key and the value, nothing written.
+  const fs::path bad = write_scene("badmesh", "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"nope.off\"\n"
+                                              "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 200\n"
+                                              "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0, 0, 0]\n"
+                                              "[outputs]\nplots = false\ndir = \"" + out.string() + "\"\n");
+  const CliRun b = run("--scene " + bad.string());
+  EXPECT_EQ(b.status, 2) << b.out;
+  EXPECT_NE(b.out.find("body.mesh"), std::string::npos) << b.out;
+  EXPECT_NE(b.out.find("nope.off"), std::string::npos) << b.out;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove(scene);
+  fs::remove(bad);
+}

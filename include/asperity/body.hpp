@@ -34,6 +34,8 @@ struct RadiusDistribution {
   static RadiusDistribution discrete(std::vector<double> levels, std::vector<double> fractions);
   /// "fixed(6.5e-07)", "lognormal(6.5e-07,0.5)", "levels(2e-06:0.2,5e-07:0.8)".
   std::string describe() const;
+
+  friend bool operator==(const RadiusDistribution&, const RadiusDistribution&) = default;
 };
 
 /// Throws std::invalid_argument naming the offending field and value (radii finite and > 0,

@@ -3,15 +3,42 @@
 // paper's figures. Every field is validated before any work starts. Scenes are written as TOML
 // files (see scene_file.hpp and README "Scenes"); the presets are such files, embedded in the
 // library at build time from scenes/*.toml.
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "asperity/body.hpp"
 #include "asperity/bounce.hpp"
 #include "asperity/ensemble.hpp"
 
 namespace asperity {
+
+/// A rough body built on a triangle mesh (mesh.hpp) instead of the paper's sphere: a run of
+/// run_mesh_impacts (body_experiments.hpp) -- ensemble.spheres explicit bodies x rotations.
+struct MeshBodyScene {
+  /// As written in the scene; load_scene resolves it (relative to the scene file's directory,
+  /// then to the meshes/ directory of the source tree or installation).
+  std::filesystem::path file;
+  double scale = 1.0;                ///< mesh coordinates -> metres
+  /// Empty: asperity centres on the facets; {a, b, c[, m]} [m]: mapped onto that (super)ellipsoid.
+  std::vector<double> smooth;
+  /// Non-empty: the first body is also written as PLY (asperity spheres) to out / export_ply.
+  std::string export_ply;
+
+  friend bool operator==(const MeshBodyScene&, const MeshBodyScene&) = default;
+};
+
+/// Unequal asperity radii on the sphere: a run of run_radii_experiment (body_experiments.hpp).
+struct RadiiScene {
+  RadiusDistribution radii;                  ///< levels or lognormal
+  std::uint64_t screen_bodies = 2;           ///< explicit spheres screened for lambda_eff
+  std::uint64_t screen_directions = 200000;  ///< random directions of the screening cross-check, per body
+
+  friend bool operator==(const RadiiScene&, const RadiiScene&) = default;
+};
 
 struct Scene {
   std::string name = "fig3";  ///< preset name, or "custom"
@@ -31,6 +58,12 @@ struct Scene {
   friend bool operator==(const Scene&, const Scene&) = default;
 
   BounceExperiment bounce;    ///< Sec. V bouncing ball (fig6); when enabled, the run is a bounce run
+  /// body.kind = "mesh": the run is run_mesh_impacts (asperity radii from `radii` if set, else
+  /// ensemble.sphere.asperity_radius); ensemble.sphere.radius is unused.
+  std::optional<MeshBodyScene> mesh;
+  /// Asperity radii "levels"/"lognormal"; on a sphere the run is run_radii_experiment.
+  /// nullopt: every asperity has radius ensemble.sphere.asperity_radius (the paper).
+  std::optional<RadiiScene> radii;
 };
 
 /// Names of the built-in presets (the files scenes/NAME.toml, embedded in the library).

@@ -3,7 +3,7 @@
 // asperities, ensemble, experiment, outputs. Documented in README "Scenes" and, key by key, in
 // scenes/example.toml. Every key is checked: unknown keys, wrong types, NaN/inf and out-of-range
 // values are errors naming the full dotted key (and the value); features the engine does not have
-// yet (mesh bodies, non-fixed asperity radii, bounce experiments, ...) are errors
+// yet (oblique impacts, constant restitution, ...) are errors
 // "not supported yet: <key> = <value>", never silently ignored.
 #include <filesystem>
 #include <stdexcept>
