@@ -502,6 +502,10 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
         out->bad("export_ply", "must be a file name inside outputs.dir, got " + quote(*p));
       s.mesh->export_ply = *p;
     }
+    if (auto st = out->choice("export_style", {"spheres", "points"})) {
+      if (!s.mesh || s.mesh->export_ply.empty()) out->bad("export_style", "only with outputs.export_ply");
+      s.mesh->export_points = *st == "points";
+    }
     if (s.mesh && !(s.contact_stats && s.restitution_stats))
       out->bad(s.contact_stats ? "restitution" : "contact", "a mesh body's run always analyses contacts and restitution");
     out->finish();
@@ -702,7 +706,9 @@ std::string to_toml(const Scene& s) {
   if (x.enabled || !s.restitution_stats) os << "restitution = " << (s.restitution_stats ? "true" : "false") << "\n";
   os << "plots = " << (s.plots ? "true" : "false") << "\nalpha = " << num(s.alpha) << "\ndir = " << quote(s.out.string())
      << "\nreport = " << quote(s.report) << "\n";
-  if (s.mesh && !s.mesh->export_ply.empty()) os << "export_ply = " << quote(s.mesh->export_ply) << "\n";
+  if (s.mesh && !s.mesh->export_ply.empty())
+    os << "export_ply = " << quote(s.mesh->export_ply) << "\nexport_style = \""
+       << (s.mesh->export_points ? "points" : "spheres") << "\"\n";
   return os.str();
 }
 

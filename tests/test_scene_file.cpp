@@ -346,6 +346,8 @@ TEST(SceneFileBodies, ExampleScenesParseIntoTheExpectedFields) {
   EXPECT_EQ(el.mesh->scale, 1.0);
   EXPECT_EQ(el.mesh->smooth, (std::vector<double>{4e-3, 3e-3, 2.25e-3}));
   EXPECT_EQ(el.mesh->export_ply, "ellipsoid.ply");
+  EXPECT_TRUE(el.mesh->export_points);
+  EXPECT_FALSE(parse_scene(kMesh).mesh->export_points);
   EXPECT_EQ(el.ensemble.sphere.asperities, 100000u);
   EXPECT_EQ(el.ensemble.sphere.asperity_radius, 6.5e-7);
   EXPECT_EQ(el.ensemble.mode, Mode::fixed);
@@ -416,6 +418,9 @@ TEST(SceneFileBodies, BadKeysInTheNewSectionsNameTheKeyAndValue) {
   expect_error(replace(kLevels, "directions = 1000", "directions = 1.5"), "screening.directions", "1.5");
   expect_error(replace(kMesh, "export_ply = \"m.ply\"", "export_ply = \"../m.ply\""), "outputs.export_ply", "../m.ply");
   expect_error(replace(kLevels, "plots = false", "plots = false\nexport_ply = \"x.ply\""), "outputs.export_ply", "mesh");
+  expect_error(replace(kMesh, "export_ply = \"m.ply\"", "export_ply = \"m.ply\"\nexport_style = \"dots\""),
+               "outputs.export_style", "dots");
+  expect_error(replace(kMesh, "export_ply = \"m.ply\"", "export_style = \"points\""), "outputs.export_style", "export_ply");
   // Combinations the runs cannot honour are refused, naming the key.
   expect_error(replace(kMesh, "mode = \"fixed\"\nspheres = 2", "mode = \"fresh\""), "ensemble.mode", "fixed");
   expect_error(replace(kMesh, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"contact\""),

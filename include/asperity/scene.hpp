@@ -27,6 +27,7 @@ struct MeshBodyScene {
   std::vector<double> smooth;
   /// Non-empty: the first body is also written as PLY (asperity spheres) to out / export_ply.
   std::string export_ply;
+  bool export_points = false;        ///< PLY of centres only (small) instead of asperity spheres
 
   friend bool operator==(const MeshBodyScene&, const MeshBodyScene&) = default;
 };

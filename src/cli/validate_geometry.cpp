@@ -214,7 +214,7 @@ int main(int argc, char** argv) {
               make_rough_mesh_body(mesh, m.asperities, m.radii, m.density, m.seed, 0, onto, m.mesh.stem().string());
           const fs::path ply = scene.out / scene.mesh->export_ply;
           written.push_back(ply);
-          write_ply(ply, b, PlyStyle::spheres, 1.0, &mesh, -mass_properties(mesh, m.density).centroid);
+          write_ply(ply, b, scene.mesh->export_points ? PlyStyle::points : PlyStyle::spheres, 1.0, &mesh, -mass_properties(mesh, m.density).centroid);
         }
         const MeshImpactReport r = run_mesh_impacts(m);
         std::cout << format_table(r);
