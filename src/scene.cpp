@@ -35,6 +35,23 @@ void validate(const Scene& s) {
     throw std::invalid_argument("report must be a file name inside out, got '" + s.report + "'");
   if (s.name.empty()) throw std::invalid_argument("name must not be empty");
   if (s.bounce.enabled) validate(s.bounce);
+  // Mesh bodies and unequal radii are the runs of body_experiments.hpp (also after command-line
+  // overrides of a scene file): only the ensembles and experiments those runs have.
+  if (s.radii) validate(s.radii->radii);
+  if (s.mesh) {
+    if (s.mesh->file.empty()) throw std::invalid_argument("mesh file must not be empty");
+    if (s.ensemble.mode != Mode::fixed)
+      throw std::invalid_argument("a mesh body needs mode fixed (explicit bodies x rotations), got " +
+                                  std::string(to_string(s.ensemble.mode)));
+    if (!s.ensemble.impact.enabled || s.bounce.enabled)
+      throw std::invalid_argument("a mesh body runs single impacts: it needs an impact experiment");
+  } else if (s.radii) {
+    if (s.ensemble.mode != Mode::fresh)
+      throw std::invalid_argument("unequal asperity radii on a sphere need mode fresh, got " +
+                                  std::string(to_string(s.ensemble.mode)));
+    if (s.ensemble.impact.enabled || s.bounce.enabled)
+      throw std::invalid_argument("unequal asperity radii on a sphere are analysed as contacts only (no impacts)");
+  }
 }
 
 }  // namespace asperity

@@ -237,6 +237,11 @@ TEST(CliScene, LevelRadiiSceneRunsTheRadiiExperiment) {
   EXPECT_TRUE(exact) << j.dump(1);
   EXPECT_TRUE(fs::exists(out / "report.txt"));
   fs::remove_all(out);
+  // Command-line overrides that the radii run cannot honour are bad input, not ignored.
+  const CliRun fixed = run("--scene " + scene.string() + " --mode fixed");
+  EXPECT_EQ(fixed.status, 2) << fixed.out;
+  EXPECT_NE(fixed.out.find("mode"), std::string::npos) << fixed.out;
+  EXPECT_FALSE(fs::exists(out));
   fs::remove(scene);
 }
 
