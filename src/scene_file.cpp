@@ -527,17 +527,22 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
 // PR #301). Such headers are never valid TOML, so they are refused here, before toml++ sees them.
 // Returns the 1-based line of the first one, 0 if there is none. Tracks strings, comments and
 // multi-line arrays so that a '[' inside a value is not taken for a header.
-std::size_t bad_table_header(std::string_view t) {
+struct SyntaxProblem {
+  std::size_t line = 0;  // 0: none found
+  const char* what = "";
+};
+
+SyntaxProblem bad_brackets(std::string_view t) {
   std::size_t line = 1;
   bool line_start = true, in_header = false;
-  int depth = 0;  // nesting of [ and { inside a value
+  std::string open;  // the [ and { open inside a value, innermost last
   const std::size_t n = t.size();
   for (std::size_t i = 0; i < n; ++i) {
     const char c = t[i];
     if (c == '\n') {
       ++line;
       in_header = false;
-      if (depth == 0) line_start = true;
+      if (open.empty()) line_start = true;
       continue;
     }
     if (c == ' ' || c == '\t' || c == '\r') continue;
@@ -566,7 +571,7 @@ std::size_t bad_table_header(std::string_view t) {
       }
       continue;
     }
-    if (line_start && depth == 0 && c == '[') {
+    if (line_start && open.empty() && c == '[') {
       std::size_t j = i + 1;
       if (j < n && t[j] == '[') ++j;
       while (j < n && (t[j] == ' ' || t[j] == '\t')) ++j;
@@ -574,7 +579,7 @@ std::size_t bad_table_header(std::string_view t) {
         const char k = t[j];
         const bool key_start = (k >= 'A' && k <= 'Z') || (k >= 'a' && k <= 'z') || (k >= '0' && k <= '9') ||
                                k == '_' || k == '-' || k == '"' || k == '\'';
-        if (!key_start) return line;
+        if (!key_start) return {line, "a table header must start with a key, e.g. [body]"};
       }
       in_header = true;
       line_start = false;
@@ -583,10 +588,15 @@ std::size_t bad_table_header(std::string_view t) {
     }
     line_start = false;
     if (in_header) continue;
-    if (c == '[' || c == '{') ++depth;
-    else if ((c == ']' || c == '}') && depth > 0) --depth;
+    if (c == '[' || c == '{') {
+      open.push_back(c);
+    } else if ((c == ']' || c == '}') && !open.empty()) {
+      // toml++ 3.3 asserts (debug) or misbehaves on a closer that does not match, e.g. [0, 1,}2].
+      if ((c == ']') != (open.back() == '[')) return {line, c == ']' ? "']' closes an inline table" : "'}' closes an array"};
+      open.pop_back();
+    }
   }
-  return 0;
+  return {};
 }
 
 // body.mesh relative to the scene file's directory, then to the meshes/ of the source tree and of
@@ -618,10 +628,8 @@ std::filesystem::path resolve_mesh(const std::filesystem::path& mesh, const std:
 }  // namespace
 
 Scene parse_scene(std::string_view toml_text, std::string_view origin) {
-  if (const std::size_t line = bad_table_header(toml_text))
-    throw SceneError(std::string(origin) + ":" + std::to_string(line) +
-                         ": TOML syntax error: a table header must start with a key, e.g. [body]",
-                     "");
+  if (const SyntaxProblem bad = bad_brackets(toml_text); bad.line != 0)
+    throw SceneError(std::string(origin) + ":" + std::to_string(bad.line) + ": TOML syntax error: " + bad.what, "");
   toml::table root;
   try {
     root = toml::parse(toml_text, std::string(origin));
