@@ -12,23 +12,16 @@
 #include <set>
 #include <string>
 
+#include "run_command.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-  int status;
-  std::string out;  // stdout + stderr
-};
+using CliRun = asperity::testing::CommandResult;
 
 CliRun run(const std::string& args) {
-  const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  return asperity::testing::run_command(std::string(VALIDATE_GEOMETRY) + " -q " + args + " 2>&1");
 }
 
 fs::path fresh_dir(const std::string& name) {

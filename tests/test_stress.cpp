@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "run_command.hpp"
 #include "asperity/contact.hpp"
 #include "asperity/ensemble.hpp"
 #include "asperity/impact.hpp"
@@ -402,19 +403,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliResult {
-  int status;
-  std::string out;
-};
+using CliResult = asperity::testing::CommandResult;
 
 CliResult run_cli(const std::string& args) {
-  const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q --no-plots " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = std::fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  return asperity::testing::run_command(std::string(VALIDATE_GEOMETRY) + " -q --no-plots " + args + " 2>&1");
 }
 
 fs::path scratch(const std::string& name) {
