@@ -537,6 +537,12 @@ SyntaxProblem bad_brackets(std::string_view t) {
   bool line_start = true, in_header = false;
   std::string open;  // the [ and { open inside a value, innermost last
   const std::size_t n = t.size();
+  // Scene files are ASCII: toml++ 3.3 reaches TOML_UNREACHABLE (undefined behaviour) classifying
+  // some non-ASCII characters, in bare keys and inside strings alike (found by fuzzing).
+  for (std::size_t i = 0, l = 1; i < n; ++i) {
+    if (t[i] == '\n') ++l;
+    if (static_cast<unsigned char>(t[i]) >= 0x80) return {l, "a non-ASCII byte (scene files are ASCII)"};
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const char c = t[i];
     if (c == '\n') {
