@@ -24,6 +24,11 @@ CliRun run(const std::string& args) {
   return asperity::testing::run_command(std::string(VALIDATE_GEOMETRY) + " -q " + args + " 2>&1");
 }
 
+std::string slurp_file(const fs::path& file) {
+  std::ifstream f(file);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+
 fs::path fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("asperity-cli-" + std::to_string(::getpid()) + "-" + name);
   fs::remove_all(d);
@@ -95,8 +100,10 @@ TEST(Cli, GoodRunWritesTheReportContract) {
   }
   EXPECT_TRUE(laws.count("eq14") && laws.count("eq18") && laws.count("exact-sphere"));
   for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
-  // No temporary files are left next to the report.
-  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().filename(), "report.json");
+  // No temporary files are left next to the report and its table.
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_TRUE(e.path().filename() == "report.json" || e.path().filename() == "report.txt") << e.path();
+  EXPECT_NE(slurp_file(out / "report.txt").find("verdict"), std::string::npos);
   fs::remove_all(out);
 }
 
@@ -154,7 +161,8 @@ TEST(CliScene, ATinySceneWritesAReportWithItsPlan) {
   EXPECT_EQ(skipped, (std::set<std::string>{"generate", "index", "impact", "plots"}));
   for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
   EXPECT_NE(j.at("scene_file").get<std::string>().find("count = 500"), std::string::npos);
-  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().filename(), "tiny.json");
+  for (const auto& e : fs::directory_iterator(out))  // the table is named after the report
+    EXPECT_TRUE(e.path().filename() == "tiny.json" || e.path().filename() == "tiny.txt") << e.path();
   fs::remove_all(out);
   fs::remove(scene);
 }
