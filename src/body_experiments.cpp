@@ -66,10 +66,32 @@ nlohmann::json json_of(const Estimate& e) { return {{"value", e.value}, {"se", e
 nlohmann::json json_of(const LawCheck& c) {
   return {{"quantity", c.quantity}, {"law", c.law},     {"lambda", c.lambda},           {"statistic", "KS"},
           {"D", c.ks.D},            {"p", c.ks.p},       {"n", c.ks.n},                  {"power_check", c.power_check},
-          {"verdict", c.verdict},   {"note", c.note}};
+          {"decisive", c.decisive}, {"verdict", c.verdict},   {"note", c.note}};
+}
+
+// f(i) for every i in [0, n), in parallel, in chunks between which progress(done, n) is reported
+// from the calling thread. Each i is independent, so the chunking never changes a result.
+template <class F>
+void for_drops(std::uint64_t n, std::uint64_t offset, std::uint64_t total, const Progress& progress, F f) {
+  constexpr std::uint64_t kChunk = 1u << 14;
+  for (std::uint64_t b = 0; b < n; b += kChunk) {
+    const std::uint64_t end = std::min(n, b + kChunk);
+    const auto m = static_cast<std::int64_t>(end - b);
+#pragma omp parallel for schedule(static)
+    for (std::int64_t j = 0; j < m; ++j) f(b + static_cast<std::uint64_t>(j));
+    if (progress) progress(offset + end, total);
+  }
 }
 
 }  // namespace
+
+bool decisive_rejection(const std::vector<LawCheck>& tests) {
+  for (const auto& t : tests)
+    if (t.decisive && t.verdict == "reject") return true;
+  return false;
+}
+bool RadiiReport::rejected() const { return decisive_rejection(tests); }
+bool MeshImpactReport::rejected() const { return decisive_rejection(tests); }
 
 void validate(const RadiiExperiment& e) {
   if (e.asperities < 1 || e.asperities > 0xffffffffull)
@@ -89,6 +111,7 @@ namespace {
 // with the fitted variance is the power check.
 RadiiReport finish_lognormal(const RadiiExperiment& e, RadiiReport& r, const std::vector<double>& rx,
                              const std::vector<double>& rxy) {
+  auto t0 = std::chrono::steady_clock::now();
   const Summary sx = summarize_batches(rx, e.screen_bodies >= 2 ? e.screen_bodies : 1, std::vector<double>{0.5});
   r.rx_std = sx.std;
   r.lambda_fit = 1.0 / (2.0 * std::numbers::pi * sx.std.value * sx.std.value);
@@ -102,8 +125,10 @@ RadiiReport finish_lognormal(const RadiiExperiment& e, RadiiReport& r, const std
                              "Gaussian with the sample variance (fitted: p is optimistic)"));
   r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_fit / (1.05 * 1.05), "gauss-lambda-fit-x1.05"), kNaN, e.alpha, true,
                              "fitted Gaussian 5% wider: must be rejected"));
-  std::filesystem::create_directories(e.out);
+  r.seconds_analysis = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
   if (e.plots && plotting_available()) {
+    std::filesystem::create_directories(e.out);
     const double hi = 4.5 / std::sqrt(2.0 * std::numbers::pi * r.lambda_fit);
     HistogramFigure fig;
     std::ostringstream t;
@@ -123,13 +148,12 @@ RadiiReport finish_lognormal(const RadiiExperiment& e, RadiiReport& r, const std
     r.plots.push_back("r_x.png");
   }
   (void)rxy;
-  write_file_atomic(e.out / "report.json", to_json(r));
-  write_file_atomic(e.out / "report.txt", format_table(r));
+  r.seconds_plots = seconds_since(t0);
   return r;
 }
 }  // namespace
 
-RadiiReport run_radii_experiment(const RadiiExperiment& e) {
+RadiiReport run_radii_experiment(const RadiiExperiment& e, const Progress& progress) {
   validate(e);
   RadiiReport r;
   r.experiment = e;
@@ -175,18 +199,16 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
     r.kept_never_hit += c.kept_never_hit;
     r.directions += c.directions;
     if (lognormal) {
-      const auto m = static_cast<std::int64_t>(M);
       const std::size_t base = rx_explicit.size();
       rx_explicit.resize(base + M);
       rxy_explicit.resize(base + M);
-#pragma omp parallel for schedule(static)
-      for (std::int64_t j = 0; j < m; ++j) {
-        Stream st(e.seed, Purpose::orientation, k * M + static_cast<std::uint64_t>(j));
+      for_drops(M, k * M, e.drops, progress, [&](std::uint64_t j) {
+        Stream st(e.seed, Purpose::orientation, k * M + j);
         const Rotation rot = random_rotation(st);
         const BodyContact bc = make_body_contact(q->support(body_down(rot)), b, rot);
         rx_explicit[base + static_cast<std::size_t>(j)] = bc.r.x();
         rxy_explicit[base + static_cast<std::size_t>(j)] = std::hypot(bc.r.x(), bc.r.y());
-      }
+      });
     }
     for (std::size_t i = 0; i < b.size(); ++i) {
       const std::size_t m = static_cast<std::size_t>(std::find(lv.begin(), lv.end(), b.radii[i]) - lv.begin());
@@ -210,20 +232,19 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
 
   // (2) Fresh drops: iid, each a pure function of (seed, drop).
   t0 = std::chrono::steady_clock::now();
-  const auto n = static_cast<std::int64_t>(e.drops);
   std::vector<double> rx(e.drops), rxy(e.drops);
   std::vector<std::uint32_t> level(e.drops);
   std::vector<std::uint8_t> core(e.drops);
-#pragma omp parallel for schedule(static)
-  for (std::int64_t k = 0; k < n; ++k) {
-    const FreshContact c = fresh_levels_contact(e.asperities, R, e.radii, e.seed, static_cast<std::uint64_t>(k));
+  for_drops(e.drops, 0, e.drops, progress, [&](std::uint64_t k) {
+    const FreshContact c = fresh_levels_contact(e.asperities, R, e.radii, e.seed, k);
     const auto i = static_cast<std::size_t>(k);
     rx[i] = c.r.x();
     rxy[i] = std::hypot(c.r.x(), c.r.y());
     level[i] = c.level;
     core[i] = c.core;
-  }
+  });
   r.seconds_fresh = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
   r.winner_level_fraction.assign(lv.size(), 0.0);
   // fresh_levels_contact numbers levels after dropping zero fractions; map back.
   std::vector<std::size_t> nz;
@@ -243,6 +264,7 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
   const Law g_all = gaussian_rx(r.lambda, "gauss-lambda");
   const Law g_top = gaussian_rx(r.lambda_top, "gauss-lambda-top");
   r.tests.push_back(ks_check("r_x", srx, exact, kNaN, e.alpha, false, "exact finite-N law, level radii"));
+  r.tests.back().decisive = true;
   r.tests.push_back(ks_check("r_x", srx, wrong, kNaN, e.alpha, true, "exact law stretched by 5%: must be rejected"));
   r.tests.push_back(ks_check("r_x", srx, g_all, r.lambda, e.alpha, false, "Eq. 18 with all asperities"));
   if (r.lambda_eff.value > 0)
@@ -253,10 +275,13 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
                              "Gaussian with the sample variance (fitted: p is optimistic)"));
   r.tests.push_back(ks_check("r_xy", srxy, levels_sphere_rxy(e.asperities, R, e.radii), kNaN, e.alpha, false,
                              "exact finite-N law of r_xy"));
+  r.tests.back().decisive = true;
+  r.seconds_analysis = seconds_since(t0);
 
-  // (4) Figures and files.
-  std::filesystem::create_directories(e.out);
+  // (4) Figures.
+  t0 = std::chrono::steady_clock::now();
   if (e.plots && plotting_available()) {
+    std::filesystem::create_directories(e.out);
     const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * std::min(r.lambda_top, r.lambda_fit));
     const double hi = 4.0 * sigma;
     HistogramFigure fig;
@@ -276,8 +301,7 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e) {
     write_histogram_png(e.out / "r_x.png", fig);
     r.plots.push_back("r_x.png");
   }
-  write_file_atomic(e.out / "report.json", to_json(r));
-  write_file_atomic(e.out / "report.txt", format_table(r));
+  r.seconds_plots = seconds_since(t0);
   return r;
 }
 
@@ -339,6 +363,7 @@ std::string to_json(const RadiiReport& r) {
   for (const auto& t : r.tests) j["tests"].push_back(json_of(t));
   j["plots"] = r.plots;
   j["seconds_fresh"] = r.seconds_fresh;
+  j["rejected"] = r.rejected();
   return j.dump(2) + "\n";
 }
 
@@ -371,9 +396,10 @@ void validate(const MeshImpactExperiment& e) {
   if (!(e.alpha > 0 && e.alpha < 1)) throw std::invalid_argument("alpha must be in (0,1), got " + num(e.alpha));
 }
 
-MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
+MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress& progress) {
   validate(e);
   const auto t0 = std::chrono::steady_clock::now();
+  auto ts = t0;
   MeshImpactReport r;
   r.experiment = e;
   const TriangleMesh mesh = read_mesh(e.mesh, e.scale);
@@ -393,14 +419,14 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
   std::vector<double> rx(n), ry(n), rz(n), rxy(n), eps(n, kNaN), wx(n, kNaN);
   std::vector<std::uint8_t> core(n, 0), hit(n, 0);
   const std::string name = e.mesh.stem().string();
+  r.seconds_mesh = seconds_since(ts);
+  ts = std::chrono::steady_clock::now();
   for (std::uint64_t k = 0; k < e.bodies; ++k) {
     const RoughBody b = make_rough_mesh_body(mesh, e.asperities, e.radii, e.density, e.seed, k, onto, name);
     if (k == 0) r.mass.area = b.area;
     const auto q = make_support_tree(b.centres, b.radii);
-    const auto m = static_cast<std::int64_t>(M);
-#pragma omp parallel for schedule(static)
-    for (std::int64_t j = 0; j < m; ++j) {
-      const std::uint64_t drop = k * M + static_cast<std::uint64_t>(j);
+    for_drops(M, k * M, e.drops, progress, [&](std::uint64_t j) {
+      const std::uint64_t drop = k * M + j;
       Stream st(e.seed, Purpose::orientation, drop);
       const Rotation rot = random_rotation(st);
       const BodyImpact bi = body_impact(b, *q, rot, Vec3(0, 0, -e.speed), e.omega, *eps_n, e.eps_t);
@@ -423,8 +449,10 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
         eps[drop] = bi.result->eps;
         wx[drop] = bi.result->Omega_after.x();
       }
-    }
+    });
   }
+  r.seconds_drops = seconds_since(ts);
+  ts = std::chrono::steady_clock::now();
   r.samples = n;
   for (std::size_t i = 0; i < n; ++i) r.no_impacts += !hit[i], r.core_contacts += core[i];
   std::vector<double> e_ok, w_ok;
@@ -473,8 +501,10 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
     r.tests.push_back(ks_check("eps", se, eq28_corrected(sc, 1.05), kNaN, e.alpha, true, "alpha x 1.05: must be rejected"));
     r.tests.push_back(ks_check("omega_x_after", sw, eq33_corrected(sc), kNaN, e.alpha, false, "Eq. 33 corrected, " + pooled));
   }
-  std::filesystem::create_directories(e.out);
+  r.seconds_analysis = seconds_since(ts);
+  ts = std::chrono::steady_clock::now();
   if (e.plots && plotting_available()) {
+    std::filesystem::create_directories(e.out);
     std::ostringstream sub;
     sub << name << (e.smooth_ellipsoid.empty() ? " (facets)" : " (smooth)") << ", N = " << e.asperities << ", "
         << e.radii.describe() << ", " << e.bodies << " x " << M;
@@ -508,9 +538,8 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e) {
       r.plots.push_back("eps.png");
     }
   }
+  r.seconds_plots = seconds_since(ts);
   r.seconds = seconds_since(t0);
-  write_file_atomic(e.out / "report.json", to_json(r));
-  write_file_atomic(e.out / "report.txt", format_table(r));
   return r;
 }
 
@@ -576,6 +605,7 @@ std::string to_json(const MeshImpactReport& r) {
   for (const auto& t : r.tests) j["tests"].push_back(json_of(t));
   j["plots"] = r.plots;
   j["seconds"] = r.seconds;
+  j["rejected"] = r.rejected();
   return j.dump(2) + "\n";
 }
 

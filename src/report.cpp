@@ -441,6 +441,46 @@ void write_file_atomic(const std::filesystem::path& file, const std::string& tex
   }
 }
 
+std::string with_header(const std::string& body, const ReportHeader& h) {
+  using nlohmann::json;
+  json j = json::parse(body);
+  if (!j.is_object()) throw std::invalid_argument("with_header: the report body must be a JSON object");
+  j["schema_version"] = kReportSchemaVersion;
+  j["tool"] = h.tool;
+  j["scene"] = h.scene;
+  if (!h.scene_toml.empty()) j["scene_file"] = h.scene_toml;
+  if (!h.plan.empty()) {
+    json plan = json::array();
+    for (const auto& st : h.plan)
+      plan.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
+                      {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
+    j["plan"] = plan;
+  }
+  if (!h.timings_s.empty()) {
+    json tm = json::object();
+    for (const auto& [k, v] : h.timings_s) tm[k] = v;
+    j["timings_s"] = tm;
+  }
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::filesystem::path> write_report_files(const std::filesystem::path& dir, const std::string& report_name,
+                                                      const std::string& json, const std::string& table) {
+  const std::filesystem::path report = dir / report_name;
+  std::filesystem::path txt = report;
+  txt.replace_extension(".txt");
+  if (txt == report) txt += ".txt";  // a report named "x.txt" keeps its table apart
+  write_file_atomic(report, json);
+  try {
+    write_file_atomic(txt, table);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(report, ec);
+    throw;
+  }
+  return {report, txt};
+}
+
 std::vector<std::string> write_plots(const std::filesystem::path& dir, const Scene& scene, const ContactSamples& s) {
   std::vector<std::string> files;
   const auto& sp = scene.ensemble.sphere;
