@@ -60,6 +60,13 @@ RadiiExperiment radii_experiment(const Scene& s) {
   return r;
 }
 
+std::vector<std::string> skipped_of(const std::vector<LawCheck>& tests) {
+  std::vector<std::string> out;
+  for (const auto& t : tests)
+    if (t.decisive && t.verdict == "skipped") out.push_back(t.quantity + " " + t.law + ": " + t.note);
+  return out;
+}
+
 PlanStage stage(std::string name, bool run, std::string reason, double seconds = 0) {
   return {std::move(name), run, std::move(reason), run ? seconds : 0.0};
 }
@@ -94,6 +101,7 @@ SceneOutput run_radii(const Scene& s, const Progress& progress) {
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
+  o.skipped = skipped_of(r.tests);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = s.name;
@@ -127,6 +135,7 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress) {
   const MeshImpactReport r = run_mesh_impacts(m, progress);
   o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
   o.rejected = r.rejected();
+  o.skipped = skipped_of(r.tests);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = s.name;
@@ -181,6 +190,8 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress) {
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
+  for (const auto& t : r.tests)
+    if (t.decisive && t.verdict == "skipped") o.skipped.push_back(t.quantity + " " + t.law + " (" + t.scope + "): " + t.note);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = r.scene.name;

@@ -460,3 +460,43 @@ TEST(CliProgress, ShownOnlyWhenTheRunIsLong) {
 }
 
 }  // namespace
+
+namespace {
+
+// A decisive law that cannot be evaluated is visible: verdict "skipped" (p, D null) in tests[],
+// a `skipped` count, the table and a warning on stderr. Exit status stays 0: nothing was rejected.
+// Here: at 1e-12 m/s some drops do not impact, so the Sec. IV laws do not apply to the sample.
+TEST(CliReport, ASkippedDecisiveLawIsVisible) {
+  for (const std::string mode : {"", " --mode fixed --spheres 4"}) {
+    const fs::path out = fresh_dir("skipped");
+    const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q --no-plots --speed 1e-12 --drops 100 --seed 2" + mode +
+                            " --out " + out.string();
+    const auto err = asperity::testing::run_command(cmd + " 2>&1 >/dev/null");
+    ASSERT_EQ(err.status, 0) << err.out;
+    EXPECT_NE(err.out.find("warning: 2 decisive tests were skipped"), std::string::npos) << err.out;
+    EXPECT_NE(err.out.find("eq28-corrected"), std::string::npos) << err.out;
+    const auto j = read_report(out / "report.json");
+    EXPECT_EQ(j.at("skipped"), 2) << mode;
+    EXPECT_EQ(j.at("rejected"), false);
+    std::set<std::string> decisive_skipped;
+    for (const auto& t : j.at("tests")) {
+      if (t.at("verdict") != "skipped") continue;
+      EXPECT_TRUE(t.at("p").is_null() && t.at("D").is_null()) << t.dump();
+      EXPECT_NE(t.at("note").get<std::string>().find("did not impact"), std::string::npos) << t.dump();
+      if (t.at("decisive").get<bool>()) decisive_skipped.insert(t.at("law").get<std::string>());
+    }
+    EXPECT_EQ(decisive_skipped, (std::set<std::string>{"eq28-corrected", "eq33-corrected"})) << mode;
+    EXPECT_NE(slurp_file(out / "report.txt").find("2 decisive tests SKIPPED"), std::string::npos);
+    fs::remove_all(out);
+  }
+  // A run without skipped laws says nothing on stderr (with -q) and counts 0.
+  const fs::path out = fresh_dir("not-skipped");
+  const auto err = asperity::testing::run_command(std::string(VALIDATE_GEOMETRY) + " -q --no-plots --preset fig4 "
+                                                  "--asperities 500 --drops 500 --out " + out.string() + " 2>&1 >/dev/null");
+  EXPECT_TRUE(err.status == 0 || err.status == 1);
+  EXPECT_EQ(err.out, "");
+  EXPECT_EQ(read_report(out / "report.json").at("skipped"), 0);
+  fs::remove_all(out);
+}
+
+}  // namespace
