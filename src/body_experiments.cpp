@@ -59,15 +59,7 @@ LawCheck ks_check(const std::string& quantity, const std::vector<double>& sorted
 }
 
 Curve curve_of(const Law& law, const std::string& label, double lo, double hi) {
-  Curve c;
-  c.label = label;
-  for (int i = 0; i <= 300; ++i) {
-    const double t = lo + (hi - lo) * i / 300.0;
-    const double y = law.pdf(t);
-    c.x.push_back(t);
-    c.y.push_back(std::isfinite(y) ? y : 0.0);
-  }
-  return c;
+  return sampled_curve(law.pdf, label, lo, hi);
 }
 
 nlohmann::json json_of(const Estimate& e) { return {{"value", e.value}, {"se", e.se}}; }
@@ -105,6 +97,15 @@ std::size_t decisive_skipped(const std::vector<LawCheck>& tests) {
 bool RadiiReport::rejected() const { return decisive_rejection(tests); }
 
 namespace {
+// tests[], plots, rejected, skipped of a report body.
+void add_tests(nlohmann::json& j, const std::vector<LawCheck>& tests, const std::vector<std::string>& plots) {
+  j["tests"] = nlohmann::json::array();
+  for (const auto& t : tests) j["tests"].push_back(json_of(t));
+  j["plots"] = plots;
+  j["rejected"] = decisive_rejection(tests);
+  j["skipped"] = decisive_skipped(tests);
+}
+
 // The table lines of tests that could not be evaluated, with the reason.
 std::string skipped_lines(const std::vector<LawCheck>& tests) {
   std::string out;
@@ -383,12 +384,8 @@ std::string to_json(const RadiiReport& r) {
   j["winner_level_fraction"] = r.winner_level_fraction;
   j["core_contacts"] = r.core_contacts;
   j["rx_std"] = json_of(r.rx_std);
-  j["tests"] = nlohmann::json::array();
-  for (const auto& t : r.tests) j["tests"].push_back(json_of(t));
-  j["plots"] = r.plots;
+  add_tests(j, r.tests, r.plots);
   j["seconds_fresh"] = r.seconds_fresh;
-  j["rejected"] = r.rejected();
-  j["skipped"] = decisive_skipped(r.tests);
   return j.dump(2) + "\n";
 }
 
@@ -641,12 +638,8 @@ std::string to_json(const MeshImpactReport& r) {
                                {"mean", json_of(q.summary.mean)},
                                {"std", json_of(q.summary.std)},
                                {"batches", q.summary.batches}});
-  j["tests"] = nlohmann::json::array();
-  for (const auto& t : r.tests) j["tests"].push_back(json_of(t));
-  j["plots"] = r.plots;
+  add_tests(j, r.tests, r.plots);
   j["seconds"] = r.seconds;
-  j["rejected"] = r.rejected();
-  j["skipped"] = decisive_skipped(r.tests);
   return j.dump(2) + "\n";
 }
 

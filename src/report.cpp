@@ -166,6 +166,21 @@ std::string fmt(double v, int prec = 4) {
   return os.str();
 }
 
+nlohmann::json plan_json(const std::vector<PlanStage>& plan) {
+  using nlohmann::json;
+  json out = json::array();
+  for (const auto& st : plan)
+    out.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
+                   {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
+  return out;
+}
+
+nlohmann::json timings_json(const std::vector<std::pair<std::string, double>>& timings) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [k, v] : timings) out[k] = v;
+  return out;
+}
+
 }  // namespace
 
 bool GeometryReport::rejected() const {
@@ -455,18 +470,10 @@ std::string to_json(const GeometryReport& r) {
   j["tests"] = tests;
   j["rejected"] = r.rejected();
   j["skipped"] = r.skipped();
-  json tm = json::object();
-  for (const auto& [k, v] : r.timings_s) tm[k] = v;
-  j["timings_s"] = tm;
+  j["timings_s"] = timings_json(r.timings_s);
   if (r.index_bytes) j["index_bytes_per_asperity"] = double(r.index_bytes) / double(e.sphere.asperities);
   j["plots"] = r.plots;
-  if (!r.plan.empty()) {
-    json plan = json::array();
-    for (const auto& st : r.plan)
-      plan.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
-                      {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
-    j["plan"] = plan;
-  }
+  if (!r.plan.empty()) j["plan"] = plan_json(r.plan);
   if (!r.scene_toml.empty()) j["scene_file"] = r.scene_toml;
   return j.dump(2) + "\n";
 }
@@ -501,18 +508,8 @@ std::string with_header(const std::string& body, const ReportHeader& h) {
   j["tool"] = h.tool;
   j["scene"] = h.scene;
   if (!h.scene_toml.empty()) j["scene_file"] = h.scene_toml;
-  if (!h.plan.empty()) {
-    json plan = json::array();
-    for (const auto& st : h.plan)
-      plan.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
-                      {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
-    j["plan"] = plan;
-  }
-  if (!h.timings_s.empty()) {
-    json tm = json::object();
-    for (const auto& [k, v] : h.timings_s) tm[k] = v;
-    j["timings_s"] = tm;
-  }
+  if (!h.plan.empty()) j["plan"] = plan_json(h.plan);
+  if (!h.timings_s.empty()) j["timings_s"] = timings_json(h.timings_s);
   return j.dump(2) + "\n";
 }
 
@@ -571,18 +568,11 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
     }
     fig.histogram = make_histogram(x, lo, hi, 60);
     for (const auto& law : set.laws) {
-      Curve c;
-      c.label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
-                : law.name == "eq18" ? "Eq. (18), Gaussian"
-                : law.name == "exact-sphere" ? "exact finite-N law on the sphere"
-                                             : law.name;
-      for (int i = 0; i <= 300; ++i) {
-        const double t = lo + (hi - lo) * i / 300.0;
-        const double y = law.pdf(t);
-        c.x.push_back(t);
-        c.y.push_back(std::isfinite(y) ? y : 0.0);
-      }
-      fig.curves.push_back(std::move(c));
+      const std::string label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
+                                : law.name == "eq18" ? "Eq. (18), Gaussian"
+                                : law.name == "exact-sphere" ? "exact finite-N law on the sphere"
+                                                             : law.name;
+      fig.curves.push_back(sampled_curve(law.pdf, label, lo, hi));
     }
     const std::string name = set.quantity + ".png";
     write_histogram_png(dir / name, fig);
