@@ -106,13 +106,21 @@ void add_tests(nlohmann::json& j, const std::vector<LawCheck>& tests, const std:
   j["skipped"] = decisive_skipped(tests);
 }
 
-// The table lines of tests that could not be evaluated, with the reason.
-std::string skipped_lines(const std::vector<LawCheck>& tests) {
-  std::string out;
+// The tests as table rows (the lambda column if asked), then why any test was skipped.
+void write_tests(std::ostream& os, const std::vector<LawCheck>& tests, const char* quantity_label, int qw, int lw,
+                 bool lambda) {
+  os << std::left << std::setw(qw) << quantity_label << std::setw(lw) << "law";
+  if (lambda) os << std::setw(13) << "lambda";
+  os << std::setw(11) << "KS D" << std::setw(11) << "p" << "verdict\n";
+  for (const auto& t : tests) {
+    os << std::setw(qw) << t.quantity << std::setw(lw) << t.law;
+    if (lambda) os << std::setw(13) << t.lambda;
+    os << std::setw(11) << t.ks.D << std::setw(11) << t.ks.p << t.verdict
+       << (t.power_check ? " (power check: must reject)" : "") << "\n";
+  }
   for (const auto& t : tests)
     if (t.verdict == "skipped")
-      out += "skipped: " + t.quantity + " " + t.law + (t.decisive ? " (decisive)" : "") + ": " + t.note + "\n";
-  return out;
+      os << "skipped: " << t.quantity << " " << t.law << (t.decisive ? " (decisive)" : "") << ": " << t.note << "\n";
 }
 }  // namespace
 bool MeshImpactReport::rejected() const { return decisive_rejection(tests); }
@@ -350,13 +358,7 @@ std::string format_table(const RadiiReport& r) {
     for (double f : r.winner_level_fraction) os << " " << f;
   }
   os << ", core contacts " << r.core_contacts << ", std(r_x) = " << r.rx_std.value << " +- " << r.rx_std.se << " m\n";
-  os << std::left << std::setw(6) << "qty" << std::setw(24) << "law" << std::setw(13) << "lambda" << std::setw(11) << "KS D"
-     << std::setw(11) << "p" << "verdict\n";
-  for (const auto& t : r.tests) {
-    os << std::setw(6) << t.quantity << std::setw(24) << t.law << std::setw(13) << t.lambda << std::setw(11) << t.ks.D
-       << std::setw(11) << t.ks.p << t.verdict << (t.power_check ? " (power check: must reject)" : "") << "\n";
-  }
-  os << skipped_lines(r.tests);
+  write_tests(os, r.tests, "qty", 6, 24, true);
   return os.str();
 }
 
@@ -599,11 +601,7 @@ std::string format_table(const MeshImpactReport& r) {
     for (const auto& x : q.summary.quantiles) os << x.value << " ";
     os << "\n";
   }
-  os << std::setw(15) << "quantity" << std::setw(28) << "law" << std::setw(11) << "KS D" << std::setw(11) << "p" << "verdict\n";
-  for (const auto& t : r.tests)
-    os << std::setw(15) << t.quantity << std::setw(28) << t.law << std::setw(11) << t.ks.D << std::setw(11) << t.ks.p << t.verdict
-       << (t.power_check ? " (power check: must reject)" : "") << "\n";
-  os << skipped_lines(r.tests);
+  write_tests(os, r.tests, "quantity", 15, 28, false);
   return os.str();
 }
 
