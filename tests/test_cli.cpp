@@ -398,6 +398,7 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {L + " --omega-y 1", "--omega-y"},
       {L + " --backend grid", "--backend: not used by a run with unequal asperity radii"},
       {L + " --spheres 3", "--spheres: not used by a run with unequal asperity radii"},
+      {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
       {M + " --radius 1e-3", "--radius: a mesh body's size"},
       {M + " --mode fresh", "--mode: 'fresh'"},
       {M + " --backend grid", "--backend: not used by a mesh body"},
@@ -497,6 +498,33 @@ TEST(CliReport, ASkippedDecisiveLawIsVisible) {
   EXPECT_EQ(err.out, "");
   EXPECT_EQ(read_report(out / "report.json").at("skipped"), 0);
   fs::remove_all(out);
+}
+
+}  // namespace
+
+namespace {
+
+// A run whose report cannot be written leaves nothing behind: not the PLY and figures it wrote
+// before, not the table (here the report's name is taken by a directory).
+TEST(CliReport, AFailedReportWriteRemovesWhatTheRunWrote) {
+  const fs::path out = fresh_dir("failwrite");
+  const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
+  const fs::path scene = write_scene("failwrite", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
+                                                      "\"\n[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\n"
+                                                      "spheres = 2\ndrops = 100\n[experiment]\nkind = \"impact\"\n"
+                                                      "V = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n[outputs]\nplots = false\n"
+                                                      "export_ply = \"m.ply\"\ndir = \"" + out.string() + "\"\n");
+  fs::create_directories(out / "report.json" / "occupied");
+  const CliRun r = run("--scene " + scene.string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("report.json"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(out / "m.ply"));
+  EXPECT_FALSE(fs::exists(out / "report.txt"));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(out)) ++entries;
+  EXPECT_EQ(entries, 1u) << "only the directory that was there before";
+  fs::remove_all(out);
+  fs::remove(scene);
 }
 
 }  // namespace
