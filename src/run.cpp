@@ -60,20 +60,30 @@ RadiiExperiment radii_experiment(const Scene& s) {
   return r;
 }
 
+std::vector<std::string> skipped_of(const std::vector<LawCheck>& tests) {
+  std::vector<std::string> out;
+  for (const auto& t : tests)
+    if (t.decisive && t.verdict == "skipped") out.push_back(t.quantity + " " + t.law + ": " + t.note);
+  return out;
+}
+
+// The header of a run of `s` from its plan; timings_s lists the stages that ran.
+ReportHeader header_of(const Scene& s, std::vector<PlanStage> plan) {
+  ReportHeader h;
+  h.scene = s.name;
+  h.scene_toml = to_toml(s);
+  for (const auto& st : plan)
+    if (st.run) h.timings_s.emplace_back(st.name, st.seconds);
+  h.plan = std::move(plan);
+  return h;
+}
+
 PlanStage stage(std::string name, bool run, std::string reason, double seconds = 0) {
   return {std::move(name), run, std::move(reason), run ? seconds : 0.0};
 }
 
 PlanStage plots_stage(const Scene& s, double seconds) {
   return stage("plots", s.plots, s.plots ? "outputs.plots" : "plots = false / --no-plots", seconds);
-}
-
-// Header timings from the stages that ran, in plan order.
-std::vector<std::pair<std::string, double>> timings_of(const std::vector<PlanStage>& plan) {
-  std::vector<std::pair<std::string, double>> t;
-  for (const auto& st : plan)
-    if (st.run) t.emplace_back(st.name, st.seconds);
-  return t;
 }
 
 // The first body of a mesh run (same seed and index as the run's body 0) as PLY.
@@ -94,22 +104,20 @@ SceneOutput run_radii(const Scene& s, const Progress& progress) {
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
+  o.skipped = skipped_of(r.tests);
   o.table = format_table(r);
-  ReportHeader h;
-  h.scene = s.name;
-  h.scene_toml = to_toml(s);
-  h.plan = {stage("screening", true,
-                  "lambda_eff: " + std::to_string(s.radii->screen_bodies) + " explicit spheres screened" +
-                      (lognormal ? ", rotated for r_x (no exact sampler for lognormal radii)" : ""),
-                  r.seconds_screen),
-            stage("query", !lognormal,
-                  lognormal ? "lognormal radii: r_x comes from rotations of the screened spheres"
-                            : "fresh drops: exact sampler of the lowest asperities (level radii)",
-                  r.seconds_fresh),
-            stage("analysis", true, "r_x against the exact level law and Gaussians with lambda, lambda_eff",
-                  r.seconds_analysis),
-            plots_stage(s, r.seconds_plots)};
-  h.timings_s = timings_of(h.plan);
+  const ReportHeader h = header_of(
+      s, {stage("screening", true,
+                "lambda_eff: " + std::to_string(s.radii->screen_bodies) + " explicit spheres screened" +
+                (lognormal ? ", rotated for r_x (no exact sampler for lognormal radii)" : ""),
+                r.seconds_screen),
+          stage("query", !lognormal,
+                lognormal ? "lognormal radii: r_x comes from rotations of the screened spheres"
+                : "fresh drops: exact sampler of the lowest asperities (level radii)",
+                r.seconds_fresh),
+          stage("analysis", true, "r_x against the exact level law and Gaussians with lambda, lambda_eff",
+                r.seconds_analysis),
+          plots_stage(s, r.seconds_plots)});
   o.json = with_header(to_json(r), h);
   return o;
 }
@@ -127,21 +135,19 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress) {
   const MeshImpactReport r = run_mesh_impacts(m, progress);
   o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
   o.rejected = r.rejected();
+  o.skipped = skipped_of(r.tests);
   o.table = format_table(r);
-  ReportHeader h;
-  h.scene = s.name;
-  h.scene_toml = to_toml(s);
-  h.plan = {stage("generate", true, "mesh, mass properties and the comparison sphere", r.seconds_mesh),
-            stage("query", true,
-                  std::to_string(m.bodies) + " explicit bodies x rotations: support tree, lowest asperity, impact",
-                  r.seconds_drops),
-            stage("analysis", true, "summaries; the sphere laws of the equal-volume sphere (measurements)",
-                  r.seconds_analysis),
-            plots_stage(s, r.seconds_plots),
-            stage("export", !s.mesh->export_ply.empty(),
-                  s.mesh->export_ply.empty() ? "no outputs.export_ply" : "outputs.export_ply: the first body as PLY",
-                  seconds_export)};
-  h.timings_s = timings_of(h.plan);
+  const ReportHeader h = header_of(
+      s, {stage("generate", true, "mesh, mass properties and the comparison sphere", r.seconds_mesh),
+          stage("query", true,
+                std::to_string(m.bodies) + " explicit bodies x rotations: support tree, lowest asperity, impact",
+                r.seconds_drops),
+          stage("analysis", true, "summaries; the sphere laws of the equal-volume sphere (measurements)",
+                r.seconds_analysis),
+          plots_stage(s, r.seconds_plots),
+          stage("export", !s.mesh->export_ply.empty(),
+                s.mesh->export_ply.empty() ? "no outputs.export_ply" : "outputs.export_ply: the first body as PLY",
+                seconds_export)});
   o.json = with_header(to_json(r), h);
   return o;
 }
@@ -166,12 +172,10 @@ SceneOutput run_bounce(const Scene& s, std::ostream* log) {
   o.files = plots;
   const double seconds_plots = since(t0);
   o.table = table.str();
-  ReportHeader h;
-  h.scene = s.name;
-  h.scene_toml = to_toml(s);
-  h.plan = {stage("bounce", true, "bounce sequences per variant, fits and bootstrap goodness of fit", seconds_bounce),
-            stage("analysis", true, "two-sample KS between variants", seconds_analysis), plots_stage(s, seconds_plots)};
-  h.timings_s = timings_of(h.plan);
+  const ReportHeader h =
+      header_of(s, {stage("bounce", true, "bounce sequences per variant, fits and bootstrap goodness of fit", seconds_bounce),
+                    stage("analysis", true, "two-sample KS between variants", seconds_analysis),
+                    plots_stage(s, seconds_plots)});
   o.json = with_header(bounce_to_json(s.name, e.sphere, s.bounce, e.seed, reports, plots, comparisons), h);
   return o;
 }
@@ -181,6 +185,8 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress) {
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
+  for (const auto& t : r.tests)
+    if (t.decisive && t.verdict == "skipped") o.skipped.push_back(t.quantity + " " + t.law + " (" + t.scope + "): " + t.note);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = r.scene.name;

@@ -398,6 +398,7 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {L + " --omega-y 1", "--omega-y"},
       {L + " --backend grid", "--backend: not used by a run with unequal asperity radii"},
       {L + " --spheres 3", "--spheres: not used by a run with unequal asperity radii"},
+      {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
       {M + " --radius 1e-3", "--radius: a mesh body's size"},
       {M + " --mode fresh", "--mode: 'fresh'"},
       {M + " --backend grid", "--backend: not used by a mesh body"},
@@ -457,6 +458,73 @@ TEST(CliProgress, ShownOnlyWhenTheRunIsLong) {
   std::fflush(f);
   EXPECT_EQ(std::ftell(f), 0L);
   std::fclose(f);
+}
+
+}  // namespace
+
+namespace {
+
+// A decisive law that cannot be evaluated is visible: verdict "skipped" (p, D null) in tests[],
+// a `skipped` count, the table and a warning on stderr. Exit status stays 0: nothing was rejected.
+// Here: at 1e-12 m/s some drops do not impact, so the Sec. IV laws do not apply to the sample.
+TEST(CliReport, ASkippedDecisiveLawIsVisible) {
+  for (const std::string mode : {"", " --mode fixed --spheres 4"}) {
+    const fs::path out = fresh_dir("skipped");
+    const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q --no-plots --speed 1e-12 --drops 100 --seed 2" + mode +
+                            " --out " + out.string();
+    const auto err = asperity::testing::run_command(cmd + " 2>&1 >/dev/null");
+    ASSERT_EQ(err.status, 0) << err.out;
+    EXPECT_NE(err.out.find("warning: 2 decisive tests were skipped"), std::string::npos) << err.out;
+    EXPECT_NE(err.out.find("eq28-corrected"), std::string::npos) << err.out;
+    const auto j = read_report(out / "report.json");
+    EXPECT_EQ(j.at("skipped"), 2) << mode;
+    EXPECT_EQ(j.at("rejected"), false);
+    std::set<std::string> decisive_skipped;
+    for (const auto& t : j.at("tests")) {
+      if (t.at("verdict") != "skipped") continue;
+      EXPECT_TRUE(t.at("p").is_null() && t.at("D").is_null()) << t.dump();
+      EXPECT_NE(t.at("note").get<std::string>().find("did not impact"), std::string::npos) << t.dump();
+      if (t.at("decisive").get<bool>()) decisive_skipped.insert(t.at("law").get<std::string>());
+    }
+    EXPECT_EQ(decisive_skipped, (std::set<std::string>{"eq28-corrected", "eq33-corrected"})) << mode;
+    EXPECT_NE(slurp_file(out / "report.txt").find("2 decisive tests SKIPPED"), std::string::npos);
+    fs::remove_all(out);
+  }
+  // A run without skipped laws says nothing on stderr (with -q) and counts 0.
+  const fs::path out = fresh_dir("not-skipped");
+  const auto err = asperity::testing::run_command(std::string(VALIDATE_GEOMETRY) + " -q --no-plots --preset fig4 "
+                                                  "--asperities 500 --drops 500 --out " + out.string() + " 2>&1 >/dev/null");
+  EXPECT_TRUE(err.status == 0 || err.status == 1);
+  EXPECT_EQ(err.out, "");
+  EXPECT_EQ(read_report(out / "report.json").at("skipped"), 0);
+  fs::remove_all(out);
+}
+
+}  // namespace
+
+namespace {
+
+// A run whose report cannot be written leaves nothing behind: not the PLY and figures it wrote
+// before, not the table (here the report's name is taken by a directory).
+TEST(CliReport, AFailedReportWriteRemovesWhatTheRunWrote) {
+  const fs::path out = fresh_dir("failwrite");
+  const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
+  const fs::path scene = write_scene("failwrite", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
+                                                      "\"\n[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\n"
+                                                      "spheres = 2\ndrops = 100\n[experiment]\nkind = \"impact\"\n"
+                                                      "V = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n[outputs]\nplots = false\n"
+                                                      "export_ply = \"m.ply\"\ndir = \"" + out.string() + "\"\n");
+  fs::create_directories(out / "report.json" / "occupied");
+  const CliRun r = run("--scene " + scene.string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("report.json"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(out / "m.ply"));
+  EXPECT_FALSE(fs::exists(out / "report.txt"));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(out)) ++entries;
+  EXPECT_EQ(entries, 1u) << "only the directory that was there before";
+  fs::remove_all(out);
+  fs::remove(scene);
 }
 
 }  // namespace

@@ -105,6 +105,16 @@ void expect_error(const std::string& text, const std::string& key, const std::st
   }
 }
 
+// parse_scene(to_toml(s)) == s for each scene.
+void expect_round_trips(const std::vector<Scene>& scenes) {
+  for (const auto& s : scenes) {
+    const std::string text = to_toml(s);
+    Scene back;
+    ASSERT_NO_THROW(back = parse_scene(text, "round-trip")) << text;
+    EXPECT_TRUE(back == s) << text;
+  }
+}
+
 }  // namespace
 
 TEST(SceneFile, EveryPresetFileEqualsThePresetAsDefinedInCode) {
@@ -139,12 +149,7 @@ TEST(SceneFile, RoundTripsThroughToToml) {
   Scene fresh_with_spheres = preset("fig3");
   fresh_with_spheres.ensemble.spheres = 100;  // e.g. fig3-fixed --mode fresh
   EXPECT_EQ(parse_scene(to_toml(fresh_with_spheres)).ensemble.spheres, 1u);
-  for (const auto& s : scenes) {
-    const std::string text = to_toml(s);
-    Scene back;
-    ASSERT_NO_THROW(back = parse_scene(text, "round-trip")) << text;
-    EXPECT_TRUE(back == s) << text;
-  }
+  expect_round_trips(scenes);
 }
 
 TEST(SceneFile, ExampleFileAndMinimalFileParse) {
@@ -380,12 +385,7 @@ TEST(SceneFileBodies, RoundTripsThroughToToml) {
   mesh_levels.mesh->export_ply.clear();
   mesh_levels.mesh->scale = 1e-3;
   scenes.push_back(mesh_levels);
-  for (const auto& s : scenes) {
-    const std::string text = to_toml(s);
-    Scene back;
-    ASSERT_NO_THROW(back = parse_scene(text, "round-trip")) << text;
-    EXPECT_TRUE(back == s) << text;
-  }
+  expect_round_trips(scenes);
 }
 
 TEST(SceneFileBodies, BadKeysInTheNewSectionsNameTheKeyAndValue) {

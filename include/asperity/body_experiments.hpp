@@ -27,7 +27,7 @@ struct LawCheck {
   /// An exact finite-N law: its rejection fails the run (exit status 1). The paper's laws applied
   /// to other radii or bodies are measurements, not pass/fail.
   bool decisive = false;
-  std::string verdict;      ///< "accept" / "reject"
+  std::string verdict;      ///< "accept" / "reject" / "skipped" (the law could not be evaluated)
   std::string note;
 };
 
@@ -71,6 +71,8 @@ struct RadiiReport {
 
 /// A decisive test rejected its law.
 bool decisive_rejection(const std::vector<LawCheck>& tests);
+/// Decisive tests that could not be evaluated (verdict "skipped": D and p NaN, the note says why).
+std::size_t decisive_skipped(const std::vector<LawCheck>& tests);
 
 /// Screens `screen_bodies` explicit spheres (Stream(seed, sphere, k)), draws `drops` fresh
 /// contacts, tests r_x against the exact level law, Gaussians with lambda, lambda_eff and the top

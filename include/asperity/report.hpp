@@ -32,7 +32,9 @@ struct TestReport {
   double predicted_mean = 0;  ///< mean of the quantity under the law (NaN if not applicable)
   bool iid = true;            ///< whether the p-value's iid assumption holds for these samples
   bool decisive = true;       ///< counts towards the exit status
-  std::string verdict;        ///< "accept", "reject", "quenched" (fixed: expected deviation), "n/a"
+  /// "accept", "reject", "quenched" (fixed: expected deviation), "skipped" (the law could not be
+  /// evaluated: D, p and predicted_mean NaN, the note says why)
+  std::string verdict;
   std::string note;
 };
 
@@ -60,6 +62,8 @@ struct GeometryReport {
 
   /// A decisive test rejected its law.
   bool rejected() const;
+  /// Decisive tests that could not be evaluated (verdict "skipped").
+  std::size_t skipped() const;
 };
 
 /// Summaries and tests of a run: the contact laws only if scene.contact_stats, the restitution laws

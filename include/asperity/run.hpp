@@ -34,6 +34,9 @@ struct SceneOutput {
   std::string table;                ///< the table for people (printed, and written as report.txt)
   std::vector<std::string> files;   ///< files the run wrote into s.out (figures, PLY), by name
   bool rejected = false;            ///< a decisive test rejected its law (exit status 1)
+  /// Decisive tests that could not be evaluated (verdict "skipped"), one line each with the
+  /// reason; the run still exits 0 unless a law was rejected (README "validate-geometry").
+  std::vector<std::string> skipped;
 };
 
 /// Runs a scene of any kind and renders its report; writes only figures (and the PLY of a mesh
