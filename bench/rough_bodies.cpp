@@ -151,14 +151,15 @@ void screen_run(const std::filesystem::path& file, const std::vector<double>& ax
   }
   const ScreeningCheck c = check_screening(b, *q, r, directions, seed);
   const auto& lv = rd.levels;
-  std::vector<double> kept(lv.size(), 0), tot(lv.size(), 0);
+  std::vector<double> kept(lv.size(), 0), tot(lv.size(), 0), unproven(lv.size(), 0);
   for (std::size_t i = 0; i < b.size(); ++i) {
     const auto l = static_cast<std::size_t>(std::find(lv.begin(), lv.end(), b.radii[i]) - lv.begin());
-    if (l < lv.size()) tot[l] += 1, kept[l] += r.status[i] != Screen::screened;
+    if (l < lv.size()) tot[l] += 1, kept[l] += r.status[i] != Screen::screened, unproven[l] += r.status[i] == Screen::helly;
   }
   std::cout << file.string() << ": N = " << n << ", area " << r.area << " m^2, lambda " << r.lambda << ", lambda_eff " << r.lambda_eff
             << " (" << r.lambda_eff / r.lambda << " lambda)\n  kept by level:";
-  for (std::size_t l = 0; l < lv.size(); ++l) std::cout << " " << lv[l] << ": " << kept[l] / tot[l];
+  for (std::size_t l = 0; l < lv.size(); ++l)
+    std::cout << " " << lv[l] << ": " << kept[l] / tot[l] << " (" << unproven[l] << " without proof)";
   std::cout << "\n  witnessed " << r.witnessed << ", kept without proof " << r.helly << ", screened " << r.screened
             << ", mean competitors " << r.mean_competitors << "\n  seconds (median of " << repeats << "): " << median(secs)
             << "\n  cross-check: " << c.directions << " directions, winners screened " << c.winners_screened << ", distinct winners "

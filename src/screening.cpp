@@ -283,8 +283,8 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
       ids.push_back(i);
     }
     // Projections onto the most violated half-space, back on the sphere; true once d is in C^S.
-    auto relax = [&](Vec3& d) {
-      for (int it = 0; it < 200; ++it) {
+    auto relax = [&](Vec3& d, int iterations) {
+      for (int it = 0; it < iterations; ++it) {
         double worst = 0;
         const HalfSpace* w = nullptr;
         for (const HalfSpace& h : comp) {
@@ -310,14 +310,16 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
     Vec3 d = nj;
     bool won = false;
     for (std::uint32_t round = 0; round < o.max_rounds; ++round) {
-      if (!relax(d)) break;
+      // Even where the relaxation has not converged (thin cells), the winner at d is a competitor
+      // worth adding: the set grows towards the asperities that close j's cell.
+      const bool feasible = relax(d, round == 0 ? 200 : 48);
       const Support sp = q.support(d);
-      if (support_value(cj, rj, d) >= sp.h) {
+      if (feasible && support_value(cj, rj, d) >= sp.h) {
         won = true;
         break;
       }
-      // Rounding only: the winner is already a competitor though d satisfies its half-space.
-      if (std::find(ids.begin(), ids.end(), sp.index) != ids.end()) break;
+      // No progress: the winner is already a competitor (d violates its half-space, or rounding).
+      if (sp.index == j || std::find(ids.begin(), ids.end(), sp.index) != ids.end()) break;
       comp.push_back({cj - b.centres[sp.index], b.radii[sp.index] - rj});
       ids.push_back(sp.index);
     }
@@ -328,8 +330,18 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
     }
     // x = 0 satisfies every half-space with beta <= 0: C^S meets B, no triple can fail.
     if (std::all_of(comp.begin(), comp.end(), [](const HalfSpace& h) { return h.beta <= 0; })) continue;
-    std::sort(comp.begin(), comp.end(),
-              [&](const HalfSpace& x, const HalfSpace& y) { return x.beta - x.n.dot(d) > y.beta - y.n.dot(d); });
+    // Most violated at d first, as an angle (far competitors have long normals): certificates come early.
+    std::vector<std::pair<double, std::size_t>> order(comp.size());
+    for (std::size_t i = 0; i < comp.size(); ++i) {
+      const double an = comp[i].n.norm();
+      order[i] = {an > 0 ? (comp[i].beta - comp[i].n.dot(d)) / an : std::numeric_limits<double>::infinity(), i};
+    }
+    std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
+    {
+      std::vector<HalfSpace> sorted(comp.size());
+      for (std::size_t i = 0; i < comp.size(); ++i) sorted[i] = comp[order[i].second];
+      comp.swap(sorted);
+    }
     const int k = static_cast<int>(comp.size());
     bool screened = false;
     if (k < 3) {
