@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "asperity/body.hpp"
+#include "asperity/body_experiments.hpp"
 #include "asperity/mesh.hpp"
 #include "asperity/random.hpp"
 #include "asperity/screening.hpp"
@@ -215,4 +216,36 @@ TEST(ScreenBody, RejectsBadOptions) {
   EXPECT_THROW(screen_body(b, *q, {.neighbours = 2}), std::invalid_argument);
   EXPECT_THROW(screen_body(b, *q, {.neighbours = 24, .max_rounds = 0}), std::invalid_argument);
   EXPECT_EQ(screen_body(b, *q).kept, 1u);
+}
+
+TEST(ScreenBody, MeshRunsReportTheScreeningOfTheirFirstBodies) {
+  MeshImpactExperiment e;
+  e.mesh = kMeshes / "rounded_cube.off";
+  e.smooth_ellipsoid = {2.5e-3, 2.5e-3, 2.5e-3, 8};
+  e.asperities = 3000;
+  e.radii = kLevels;
+  e.bodies = 3;
+  e.drops = 30;
+  e.screen_bodies = 2;
+  e.screen_directions = 20000;
+  e.plots = false;
+  e.out = std::filesystem::temp_directory_path() / "asperity-test-mesh-screening";
+  const MeshImpactReport r = run_mesh_impacts(e);
+  const MeshScreening& s = r.screening;
+  EXPECT_EQ(s.bodies, 2u);
+  EXPECT_EQ(s.witnessed + s.helly + s.screened, 6000u);
+  EXPECT_EQ(s.winners_screened, 0u);
+  EXPECT_EQ(s.directions, 40000u);
+  ASSERT_EQ(s.kept_fraction_by_level.size(), 2u);
+  EXPECT_EQ(s.kept_fraction_by_level[0], 1.0);
+  EXPECT_LT(s.kept_fraction_by_level[1], 1.0);
+  EXPECT_NEAR(s.lambda_eff.value / s.lambda, s.kept_fraction, 0.02);
+  EXPECT_NE(to_json(r).find("\"screening\""), std::string::npos);
+  EXPECT_NE(format_table(r).find("screening (2 bodies)"), std::string::npos);
+  // Equal radii: no screening section.
+  e.radii = RadiusDistribution::fixed(6.5e-7);
+  const MeshImpactReport f = run_mesh_impacts(e);
+  EXPECT_EQ(f.screening.bodies, 0u);
+  EXPECT_EQ(to_json(f).find("\"screening\""), std::string::npos);
+  std::filesystem::remove_all(e.out);
 }
