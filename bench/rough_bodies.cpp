@@ -181,7 +181,8 @@ void screen_run(const std::filesystem::path& file, const std::vector<double>& ax
       for (std::size_t i = 0; i < s.size(); ++i)
         if (s.radii[i] == lv[small]) t += 1, k += rs.status[i] != Screen::screened;
       cal.emplace_back(lam_top * drho * R, k / t);
-      std::cout << "  sphere R = " << R << " m, N = " << p.asperities << ": x = " << cal.back().first << ", small kept " << cal.back().second << "\n";
+      std::cout << "  sphere R = " << R << " m, N = " << p.asperities << ": x = " << cal.back().first << ", small kept " << cal.back().second
+                << ", screen_sphere " << rs.seconds << " s\n";
     }
   }
   auto f = [&](double x) {
