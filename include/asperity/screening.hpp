@@ -69,10 +69,12 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q);
 /// Choice of S_j (cutting planes from the exact support query, "the asperities that win around
 /// n_j"): start with the centres within L0 = sqrt(neighbours * area / (pi N)) of c_j (q.within)
 /// and the direction n_j = the smallest principal axis of those centres, oriented by n.c_j > 0.
-/// Repeat: relax d on S towards C_j^S (projections onto the most violated half-space); ask the
-/// support query who wins at d. If j does (h_j >= max h): kept, WITNESS. Otherwise the winner's
-/// half-space is violated at d: add it to S_j and go on. When the relaxation finds no point of
-/// C_j^S on S (or after max_rounds), triples of S_j are tried: one missing B screens j. The
+/// Repeat: relax d on S towards C_j^S (over-relaxed rotations towards the most violated
+/// half-space); ask the support query who wins at d. If d is in C_j^S and j wins (h_j >= max h):
+/// kept, WITNESS. Otherwise, if the winner is new, its half-space (violated at d) joins S_j, also
+/// when the relaxation stalled (thin or empty cells: this is what finds the far large asperities
+/// on flat faces). When the winner repeats (or after max_rounds), triples of S_j are tried, most
+/// violated at d first: one missing B screens j. The
 /// winners near the directions where j could win are exactly the asperities that cut its cell,
 /// so S_j is usually enough; on flat faces, where a large asperity screens small ones at any
 /// distance, the winners found are those far ones. If no triple fails, j is kept WITHOUT proof
