@@ -81,6 +81,11 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q);
 /// (status helly, counted separately): C_j^S meets B, but a competitor outside S_j may still
 /// close the cell (then j is over-kept, never wrongly screened), and for centres inside the hull
 /// of others (non-convex bases) the ball test itself cannot see C_j inside the open ball.
+/// Lifted to 4D, (c_i, rho_i), j can touch iff it is a vertex of their hull AND its normal cone
+/// meets the light cone {(d, 1) : |d| = 1}; the hull alone decides nothing, so no CGAL hull is used.
+/// CGAL's exact QP solver (QP_functions.h) could compute min |x| over C_j^S exactly; it answers the
+/// same question as the Helly triples (reused from screen_sphere, cheap for ~30 competitors) and
+/// would not remove the locality gap behind "kept without proof".
 struct BodyScreeningOptions {
   std::uint32_t neighbours = 24;   ///< expected number of initial local competitors (sets L0)
   std::uint32_t max_rounds = 48;   ///< support queries per asperity (cutting planes)
