@@ -108,6 +108,9 @@ struct FreeRotation::Impl {
     return 2 * m * GK + std::copysign(quad(std::abs(r)), r);
   }
   Vec3 w_work(double u) const {
+    // Reduced by whole periods first, so that sn^2 + cn^2 = 1 and dn^2 + k^2 sn^2 = 1 hold to
+    // rounding at any t (T and |L| conserved); the phase keeps its unavoidable error eps u.
+    if (kind == Kind::periodic) u -= 4 * K * std::round(u / (4 * K));
     double cn, dn;
     const double sn = boost::math::jacobi_elliptic(k, u, &cn, &dn);
     return {A[0] * cn, A[1] * sn, A[2] * dn};
