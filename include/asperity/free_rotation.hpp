@@ -8,9 +8,9 @@
 // The motion is solved exactly (Jacobi elliptic functions for the body-frame angular velocity, and
 // the angle about L by Gauss-Legendre quadrature of a periodic integrand), not integrated step by
 // step: `at(t)` is a pure function of t, so any time can be asked in any order (root finding for
-// the next contact goes back and forth), with an error that does not grow with the number of calls. Degenerate cases (spherical and
-// symmetric tops, principal axes, the separatrix, rest) are exact cases of the same formulas
-// (no switching thresholds); src/free_rotation.cpp derives them.
+// the next contact goes back and forth), with an error that does not grow with the number of
+// calls. Degenerate cases (spherical and symmetric tops, principal axes, the separatrix, rest) are
+// exact cases of the same formulas (no switching thresholds); src/free_rotation.cpp derives them.
 //
 // Frames and units: q maps body to world (orientation.hpp), Omega is the WORLD-frame angular
 // velocity [rad/s], J_b the body-frame inertia about the centre of mass [kg m^2], t [s].
