@@ -60,7 +60,8 @@ void BM_FreeRotation_exact(benchmark::State& st) {
   std::size_t i = 0;
   for (auto _ : st) benchmark::DoNotOptimize(f.at(t[i++ % t.size()]));
   double e = 0;
-  for (double x : t) e = std::max(e, dist(f.at(x), detail::reference_free_rotation(c.J, c.q0, c.w0, x, 1e-13), c.w0.norm()));
+  for (double x : t)
+    e = std::max(e, dist(f.at(x), detail::reference_free_rotation(c.J, c.q0, c.w0, x, 1e-13), c.w0.norm()));
   st.counters["max_err"] = e;
 }
 BENCHMARK(BM_FreeRotation_exact)->Arg(0)->Arg(1);
@@ -74,10 +75,13 @@ void BM_FreeRotation_odeint(benchmark::State& st) {
   std::size_t i = 0;
   for (auto _ : st) benchmark::DoNotOptimize(detail::reference_free_rotation(c.J, c.q0, c.w0, t[i++ % t.size()], tol));
   double e = 0;
-  for (double x : t) e = std::max(e, dist(f.at(x), detail::reference_free_rotation(c.J, c.q0, c.w0, x, tol), c.w0.norm()));
+  for (double x : t)
+    e = std::max(e, dist(f.at(x), detail::reference_free_rotation(c.J, c.q0, c.w0, x, tol), c.w0.norm()));
   st.counters["max_err"] = e;
 }
-BENCHMARK(BM_FreeRotation_odeint)->Args({0, 8})->Args({0, 10})->Args({0, 13})->Args({1, 8})->Args({1, 10})->Args({1, 13});
+BENCHMARK(BM_FreeRotation_odeint)
+    ->Args({0, 8})->Args({0, 10})->Args({0, 13})
+    ->Args({1, 8})->Args({1, 10})->Args({1, 13});
 }  // namespace
 
 BENCHMARK_MAIN();
