@@ -7,6 +7,7 @@
 #include <boost/math/special_functions/ellint_1.hpp>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <stdexcept>
 #include <vector>
 
@@ -322,6 +323,32 @@ TEST(FreeRotation, NearDegenerateMomentsAreContinuous) {
               << d << " " << sphere << " " << t;
       }
     }
+  }
+}
+
+TEST(FreeRotation, PrecessionRateIsLandaus) {
+  // Landau's Euler angles with Z along L: the line of nodes N = Z x e3 turns at
+  // dphi/dt = |L| (J1 w1^2 + J2 w2^2) / (J1^2 w1^2 + J2^2 w2^2). at() uses another gauge (the
+  // minimal rotation of l onto e3), so this checks the orientation by an independent formula.
+  // Central differences with h = 1e-4 s: truncation ~h^2 |d3phi/dt3| ~ 1e-8, tolerance 1e-7.
+  const double J1 = 1, J2 = 2, J3 = 2.5;
+  const Rotation q0 = Rotation(0.2, 0.5, -0.4, 0.7).normalized();
+  const FreeRotation f(diag(J1, J2, J3), q0, q0 * Vec3(0.3, 0.2, 1.0));
+  const Vec3 Z = f.angular_momentum().normalized();
+  const Vec3 X = Z.unitOrthogonal(), Y = Z.cross(X);
+  auto phi = [&](double t) {
+    const Vec3 N = Z.cross(f.at(t).q * Vec3::UnitZ());
+    return std::atan2(N.dot(Y), N.dot(X));
+  };
+  const double h = 1e-4;
+  for (double t : {0.0, 0.7, 2.9, 6.1, -4.4}) {
+    const RotationState s = f.at(t);
+    const Vec3 w = s.q.conjugate() * s.omega;
+    const double rate = f.angular_momentum().norm() * (J1 * w.x() * w.x() + J2 * w.y() * w.y()) /
+                        (J1 * J1 * w.x() * w.x() + J2 * J2 * w.y() * w.y());
+    double d = phi(t + h) - phi(t - h);
+    d -= 2 * std::numbers::pi * std::round(d / (2 * std::numbers::pi));
+    EXPECT_NEAR(d / (2 * h), rate, 1e-7 * rate) << t;
   }
 }
 
