@@ -82,7 +82,8 @@ void validate(const Eigen::Matrix3d& J, const Rotation& q0, const Vec3& w0) {
 // d32 = 0 (then both terms vanish) means J w || w: a steady rotation about a principal axis (incl.
 // rest, the spherical top and the unstable intermediate axis); any other c = 0 is the separatrix
 // (k = 1: sn = tanh, cn = dn = sech). Symmetric tops are k = 0 (regular precession), and nearly
-// degenerate moments are just small k or wp: every denominator is bounded away from 0 in its regime.
+// degenerate moments are just small k or wp: the parameters are products and quotients of the
+// signed differences d_ij (no cancellation), so they keep their relative precision as d_ij -> 0.
 struct FreeRotation::Impl {
   enum class Kind { steady, periodic, separatrix } kind = Kind::steady;
   Rotation q0;
