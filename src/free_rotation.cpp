@@ -77,10 +77,13 @@ void validate(const Eigen::Matrix3d& J, const Rotation& q0, const Vec3& w0) {
 // (The third-kind elliptic integral form of G cancels catastrophically as c -> 1, i.e. near pure
 // rotation about axis 3: its two terms grow like 1 / (1 - c^2).)
 //
-// No threshold separates the cases: c = L^2 - 2 T J2 (without cancellation of the large terms)
-// decides the regime; exactly 0 with w1 = w3 = 0 or J2 = J3 ... is a steady rotation about a principal
-// axis (incl. rest and the spherical top), else the separatrix (k = 1: sn = tanh, cn = dn = sech).
-// Symmetric tops are k = 0 (regular precession) and near-degenerate moments are just small k or wp.
+// No threshold separates the cases: c = L^2 - 2 T J2 = J3 d32 w3^2 - J1 d21 w1^2 (without the
+// cancellation of the large terms of L^2 and 2 T J2) decides the regime. c = 0 with w3 = 0 or
+// d32 = 0 (then both terms vanish) means J w || w: a steady rotation about a principal axis (incl.
+// rest, the spherical top and the unstable intermediate axis); any other c = 0 is the separatrix
+// (k = 1: sn = tanh, cn = dn = sech). Symmetric tops are k = 0 (regular precession), and nearly
+// degenerate moments are just small k or wp: the parameters are products and quotients of the
+// signed differences d_ij (no cancellation), so they keep their relative precision as d_ij -> 0.
 struct FreeRotation::Impl {
   enum class Kind { steady, periodic, separatrix } kind = Kind::steady;
   Rotation q0;

@@ -39,11 +39,12 @@ struct Body {
 };
 // Principal moments from random second moments x, y, z of a mass distribution (J1 = y + z, ...),
 // so the triangle inequality holds by construction; random principal frame, orientation and spin
-// direction; mass scale 1e-2..1e2, |Omega| log-uniform in [1e-3, 1e3] rad/s.
+// direction; moment scale log-uniform in 1e-12..1e2 kg m^2 (a 3 mm grain has ~4e-10), |Omega|
+// log-uniform in [1e-3, 1e3] rad/s.
 Body random_body(std::uint64_t i) {
   Stream s(7, Purpose::test, i);
   const double x = s.uniform(), y = s.uniform(), z = s.uniform();
-  const double m = std::pow(10.0, 4 * s.uniform() - 2);
+  const double m = std::pow(10.0, 14 * s.uniform() - 12);
   Body b;
   b.J = body_inertia(m * (y + z), m * (x + z), m * (x + y), random_rotation(s));
   b.q0 = random_rotation(s);
