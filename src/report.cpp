@@ -275,7 +275,8 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
     if (fixed && all_drops) {
       for (std::size_t k = 0; k < K; ++k) {
         first.push_back(x[k * M]);
-        if (!s.eps_core.empty()) first_core.push_back(s.eps_core[k * M]);
+        // eps_core runs parallel to eps, which has every drop only when every drop impacted.
+        if (s.eps_core.size() == n) first_core.push_back(s.eps_core[k * M]);
       }
     }
     for (std::size_t li = 0; li < set.laws.size(); ++li) {
