@@ -22,12 +22,15 @@
 // chatter) is found as soon as it does. The result is a lower bound t on the landing time with
 // t* - t <= time_tolerance (to first order).
 //
-// Stop rule (checked before every impact, in this order; each counted): (1) the contact point does
-// not approach the plate (no impact: grazing lift-off); (2) impact speed u = -V_z < stop_speed, the
-// fig6 rule (bounce.hpp), so that impacts per sequence compare with the sphere's; an impact whose
-// centre is RISING (u <= 0: the body rocks onto another asperity) ends the sequence too and is
-// counted apart as "rising"; (3) k > max_impacts; (4) total time > max_time; (5) a flight needing
-// more than max_steps support queries (never seen; a safety net).
+// Stop rule (checked before every impact, in this order; each counted): (1) impact speed
+// u = -V_z < stop_speed, the fig6 rule (bounce.hpp), so that impacts per sequence compare with the
+// sphere's; an impact whose centre is RISING (u <= 0: the body rocks onto another asperity) ends
+// the sequence too and is counted apart as "rising" -- below stop_speed the experiment's microphone
+// no longer separates impacts, and the motion that follows is rocking/rolling, not bouncing;
+// (2) k > max_impacts; (3) total time > max_time; (4) the contact point does not approach the plate
+// (no impact: a grazing landing); (5) a flight needing more than max_steps support queries (a
+// safety net). Chatter (many short flights) cannot run forever: every impact dissipates, u falls
+// below stop_speed or (2)/(3) end it; the fraction of flights < 1 ms is reported.
 //
 // Frames and units: world z up, plate normal +z, q body -> world, SI (m, s, kg, rad/s, J).
 // Randomness: sequence s uses body s mod K and the initial Haar orientation from
@@ -117,11 +120,11 @@ struct BodyBounceSamples {
   std::vector<Vec3> r;                ///< contact vector, world frame [m]
   std::vector<Vec3> omega_after;      ///< Omega', world frame [rad/s]
   std::vector<double> energy_before, energy_after;  ///< total energy (potential from the plate) [J]
-  std::vector<double> rot_energy_after;  ///< rotational energy after [J]
+  std::vector<double> rot_energy_after, trans_energy_after;  ///< rotational / translational energy after [J]
   std::vector<double> work;           ///< P . (v + v')/2 of the contact point velocities [J]
   std::vector<double> flight;         ///< flight time after the impact (NaN after the last) [s]
   std::vector<std::uint32_t> queries; ///< support queries of that flight
-  std::vector<double> first_speed_energy;  ///< per sequence: energy at the first impact [J]
+  std::vector<double> first_energy;   ///< per sequence: total energy at the first impact [J]
   BodyBounceStops stops;
   std::uint64_t flights = 0, support_queries = 0;
   double seconds = 0;
