@@ -11,7 +11,18 @@
 #include <memory>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <iomanip>
+#include <locale>
+#include <numbers>
+#include <sstream>
+
 #include "asperity/body_impact.hpp"
+#include "asperity/mesh.hpp"
+#include "asperity/plot.hpp"
+#include "asperity/report.hpp"
 #include "asperity/random.hpp"
 #include "asperity/restitution.hpp"
 #include "format.hpp"
@@ -102,14 +113,14 @@ namespace {
 
 struct Record {
   std::uint32_t k;
-  double u, eps, eps_time;
+  double u, vn, eps, eps_time;
   float spin, wx;
   Vec3 r, omega_after;
   double e_before, e_after, rot_after, trans_after, work, flight;
   std::uint32_t queries;
 };
 
-enum class Stop : std::uint8_t { slow, rising, no_approach, max_impacts, max_time, max_steps };
+enum class Stop : std::uint8_t { slow, no_approach, max_impacts, max_time, max_steps };
 
 struct SequenceOut {
   std::vector<Record> impacts;
@@ -128,15 +139,14 @@ void run_sequence(std::uint64_t s, const RoughBody& b, const BodyBounds& bb, con
   double T_prev = kNaN, time = 0;
   for (std::uint32_t k = 1;; ++k) {
     const double u = -V.z();
-    if (u <= 0) { out.stop = Stop::rising; return; }
-    if (u < o.bounce.stop_speed) { out.stop = Stop::slow; return; }
     if (time > o.max_time) { out.stop = Stop::max_time; return; }
     const BodyImpact bi = body_impact(b, index, q, V, W, eps_n, o.bounce.eps_t);
     if (!bi.result) { out.stop = Stop::no_approach; return; }
     const ImpactResult& res = *bi.result;
+    if (-res.v_n < o.bounce.stop_speed) { out.stop = Stop::slow; return; }
     const Vec3& r = bi.contact.r;
     Record rec;
-    rec.k = k, rec.u = u, rec.eps = res.eps, rec.spin = static_cast<float>(W.norm());
+    rec.k = k, rec.u = u, rec.vn = -res.v_n, rec.eps = res.eps, rec.spin = static_cast<float>(W.norm());
     rec.wx = static_cast<float>(res.Omega_after.x());
     rec.r = r, rec.omega_after = res.Omega_after;
     rec.e_before = body_energy(b, q, V, W, z, g);
@@ -172,7 +182,7 @@ void run_sequence(std::uint64_t s, const RoughBody& b, const BodyBounds& bb, con
 }  // namespace
 
 BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const BodyBounceOptions& o, std::uint64_t seed,
-                                   int threads) {
+                                   int threads, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
   validate(o);
   if (bodies.empty()) throw std::invalid_argument("bounce: no bodies");
   for (const auto& b : bodies)
@@ -187,7 +197,7 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
   BodyBounceSamples S;
   S.base.variant = BounceVariant::dynamic;
   S.base.sequences = n;
-  const std::uint64_t chunk = 1024;
+  const std::uint64_t chunk = 256;
   std::vector<SequenceOut> outs(static_cast<std::size_t>(std::min(chunk, n)));
   const int nt = threads > 0 ? threads : omp_get_max_threads();
   for (std::uint64_t start = 0; start < n; start += chunk) {
@@ -210,14 +220,13 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
         S.r.push_back(x.r), S.omega_after.push_back(x.omega_after);
         S.energy_before.push_back(x.e_before), S.energy_after.push_back(x.e_after);
         S.rot_energy_after.push_back(x.rot_after), S.trans_energy_after.push_back(x.trans_after);
-        S.work.push_back(x.work), S.flight.push_back(x.flight), S.queries.push_back(x.queries);
+        S.work.push_back(x.work), S.contact_speed.push_back(x.vn), S.flight.push_back(x.flight), S.queries.push_back(x.queries);
         S.support_queries += x.queries, S.flights += x.queries > 0;
       }
       S.first_energy.push_back(out.e0);
       auto& c = S.stops;
       switch (out.stop) {
         case Stop::slow: ++c.slow; break;
-        case Stop::rising: ++c.rising; break;
         case Stop::no_approach: ++c.no_approach; break;
         case Stop::max_impacts: ++c.max_impacts; break;
         case Stop::max_time: ++c.max_time; break;
@@ -225,6 +234,7 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
       }
       S.base.no_impacts += out.stop == Stop::no_approach;
     }
+    if (progress) progress(start + static_cast<std::uint64_t>(m), n);
   }
   S.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   S.base.seconds = S.seconds;
@@ -245,9 +255,9 @@ BodyBounceReport analyse_body_bounces(const BodyBounceSamples& s, const BounceEx
   m /= ns;
   r.impacts_per_sequence_sd = std::sqrt(std::max(0.0, m2 / ns - m * m));
   r.queries_per_flight = s.flights ? static_cast<double>(s.support_queries) / static_cast<double>(s.flights) : kNaN;
-  double below = 0, above = 0, rot = 0, last = 0, shortf = 0, flights = 0;
+  double below = 0, above = 0, rising = 0, rot = 0, last = 0, shortf = 0, flights = 0, gains = 0;
   for (std::size_t j = 0; j < n; ++j) {
-    below += B.eps[j] < 0, above += B.eps[j] > 1;
+    below += B.eps[j] < 0, above += B.eps[j] > 1, rising += B.speed[j] <= 0;
     const double E = std::abs(s.energy_before[j]);
     r.work_identity_max = std::max(r.work_identity_max, std::abs((s.energy_after[j] - s.energy_before[j]) - s.work[j]) / E);
     const bool last_of_seq = j + 1 == n || B.sequence[j + 1] != B.sequence[j];
@@ -258,12 +268,233 @@ BodyBounceReport analyse_body_bounces(const BodyBounceSamples& s, const BounceEx
       r.flight_energy_max = std::max(r.flight_energy_max, std::abs(s.energy_before[j + 1] - s.energy_after[j]) / E);
     }
     if (std::isfinite(s.flight[j])) shortf += s.flight[j] < 1e-3, ++flights;
+    const double gain = (s.energy_after[j] - s.energy_before[j]) / E;
+    gains += gain > 0, r.energy_gain_max = std::max(r.energy_gain_max, gain);
   }
   r.eps_below_0 = n ? below / static_cast<double>(n) : kNaN;
+  r.rising_fraction = n ? rising / static_cast<double>(n) : kNaN;
   r.eps_above_1 = n ? above / static_cast<double>(n) : kNaN;
   r.rot_fraction_last = last ? rot / last : kNaN;
   r.short_flights = flights ? shortf / flights : kNaN;
+  r.energy_gain_fraction = n ? gains / static_cast<double>(n) : kNaN;
   return r;
+}
+
+void validate(const MeshBounceExperiment& e) {
+  validate(e.options);
+  if (!e.mesh.empty()) {
+    if (!std::isfinite(e.scale) || !(e.scale > 0)) throw std::invalid_argument("mesh scale must be finite and > 0, got " + num(e.scale));
+    if (!e.smooth.empty() && e.smooth.size() != 3 && e.smooth.size() != 4)
+      throw std::invalid_argument("smooth surface needs 3 semi-axes and an optional exponent, got " + std::to_string(e.smooth.size()) +
+                                  " numbers");
+  } else if (!std::isfinite(e.sphere_radius) || !(e.sphere_radius > 0)) {
+    throw std::invalid_argument("sphere radius must be finite and > 0 m, got " + num(e.sphere_radius));
+  }
+  if (e.asperities < 1 || e.asperities > 0xffffffffull)
+    throw std::invalid_argument("asperities must be in [1, 2^32-1], got " + std::to_string(e.asperities));
+  validate(e.radii);
+  if (!std::isfinite(e.density) || !(e.density > 0)) throw std::invalid_argument("density must be finite and > 0, got " + num(e.density));
+  if (e.bodies < 1) throw std::invalid_argument("bodies must be >= 1, got 0");
+}
+
+namespace {
+
+std::string fmt(const char* f, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, x);
+  return buf;
+}
+
+// eps against impact speed: mean +- se and the 10/90% quantiles in speed bins, eps_n(u) of Eq. 9
+// (what a smooth sphere would give) for reference.
+void plot_eps_vs_speed(const std::filesystem::path& png, const BodyBounceSamples& s, const BounceExperiment& b,
+                       const std::string& title) {
+  const auto& B = s.base;
+  const double lo = b.stop_speed, hi = b.speed;
+  const int bins = 18;
+  std::vector<std::vector<double>> by(bins);
+  for (std::size_t j = 0; j < B.eps.size(); ++j) {
+    const int k = static_cast<int>((B.speed[j] - lo) / (hi - lo) * bins);
+    if (k >= 0 && k < bins) by[static_cast<std::size_t>(k)].push_back(B.eps[j]);
+    else if (B.speed[j] == hi) by[bins - 1].push_back(B.eps[j]);
+  }
+  const auto en = viscoelastic_pade14(b.beta);
+  write_gnuplot_png(png, [&](const std::filesystem::path& out) {
+    std::ostringstream o;
+    o.imbue(std::locale::classic());
+    o.precision(10);
+    o << "$m << EOD\n";
+    for (int k = 0; k < bins; ++k) {
+      auto& v = by[static_cast<std::size_t>(k)];
+      if (v.size() < 5) continue;
+      std::sort(v.begin(), v.end());
+      double m = 0, m2 = 0;
+      for (double x : v) m += x;
+      m /= static_cast<double>(v.size());
+      for (double x : v) m2 += (x - m) * (x - m);
+      const double se = std::sqrt(m2 / static_cast<double>(v.size() - 1) / static_cast<double>(v.size()));
+      o << lo + (k + 0.5) * (hi - lo) / bins << ' ' << m << ' ' << se << ' ' << quantile_sorted(v, 0.1) << ' '
+        << quantile_sorted(v, 0.9) << '\n';
+    }
+    o << "EOD\n$n << EOD\n";
+    for (int i = 0; i <= 100; ++i) {
+      const double u = lo + (hi - lo) * i / 100.0;
+      o << u << ' ' << (*en)(u) << '\n';
+    }
+    o << "EOD\nset encoding utf8\nset terminal pngcairo size 900,600 enhanced font 'sans,12'\nset output '" << out.string()
+      << "'\nset title '" << title << "'\nset xlabel 'impact speed u = -V_z [m/s]'\nset ylabel '{/Symbol e} = -V''_z/V_z'\n"
+      << "set key bottom right\nset grid\n"
+      << "plot $m using 1:4:5 with filledcurves lc rgb '#cce0f0' title '10%-90% of impacts', \\\n"
+      << "  $m using 1:2:3 with yerrorbars pt 7 ps 0.8 lc rgb '#0072B2' title 'mean {/Symbol \\261} se', \\\n"
+      << "  $n using 1:2 with lines lw 2 lc rgb '#D55E00' title '{/Symbol e}_n(u), Eq. (9): smooth sphere'\nunset output\n";
+    return o.str();
+  });
+}
+
+}  // namespace
+
+MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e) {
+  validate(e);
+  MeshBounceReport r;
+  r.experiment = e;
+  r.experiment.progress = {};
+  const auto t0 = std::chrono::steady_clock::now();
+  auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
+  std::vector<RoughBody> bodies(static_cast<std::size_t>(e.bodies));
+  if (!e.mesh.empty()) {
+    const TriangleMesh mesh = read_mesh(e.mesh, e.scale);
+    SurfaceMap onto;
+    if (!e.smooth.empty())
+      onto = superellipsoid_surface(e.smooth[0], e.smooth[1], e.smooth[2], e.smooth.size() == 4 ? e.smooth[3] : 2.0);
+    r.body_name = e.mesh.stem().string();
+    for (std::uint64_t k = 0; k < e.bodies; ++k)
+      bodies[static_cast<std::size_t>(k)] = make_rough_mesh_body(mesh, e.asperities, e.radii, e.density, e.seed, k, onto, r.body_name);
+  } else {
+    SphereParams p;
+    p.asperities = e.asperities, p.radius = e.sphere_radius;
+    r.body_name = "sphere";
+    for (std::uint64_t k = 0; k < e.bodies; ++k)
+      bodies[static_cast<std::size_t>(k)] = make_rough_sphere_body(p, e.radii, e.seed, k, e.density);
+  }
+  r.mass = bodies[0].mass;
+  r.principal_moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(bodies[0].inertia, Eigen::EigenvaluesOnly).eigenvalues();
+  for (const auto& b : bodies) r.c_max = std::max(r.c_max, BodyBounds::of(b).c_max);
+  r.seconds_build = since(t0);
+  const auto t1 = std::chrono::steady_clock::now();
+  const BodyBounceSamples S = run_body_bounces(bodies, e.options, e.seed, e.threads, e.progress);
+  r.seconds_run = since(t1);
+  const auto t2 = std::chrono::steady_clock::now();
+  r.report = analyse_body_bounces(S, e.options.bounce, e.seed);
+  std::filesystem::create_directories(e.out);
+  if (e.plots && plotting_available()) {
+    std::ostringstream sub;
+    sub << r.body_name << ", N = " << e.asperities << ", " << e.options.bounce.sequences << " sequences";
+    plot_eps_vs_speed(e.out / "eps_vs_speed.png", S, e.options.bounce, "{/Symbol e} against impact speed: " + sub.str());
+    r.plots.push_back("eps_vs_speed.png");
+    for (const auto& g : r.report.base.groups) {
+      if (g.by != "speed" || g.n < 20) continue;
+      std::vector<double> x;
+      for (std::size_t j = 0; j < S.base.eps.size(); ++j)
+        if (S.base.speed[j] >= g.lo && S.base.speed[j] <= g.hi) x.push_back(S.base.eps[j]);
+      std::sort(x.begin(), x.end());
+      const double lo = quantile_sorted(x, 0.0), hi = quantile_sorted(x, 1.0);
+      const double pad = 0.02 * (hi - lo) + 1e-9;
+      HistogramFigure fig;
+      fig.title = "{/Symbol e}, u in [" + fmt("%.2f", g.lo) + ", " + fmt("%.2f", g.hi) + "] m/s: " + sub.str() + " (n = " +
+                  std::to_string(x.size()) + ")";
+      fig.xlabel = "{/Symbol e} = -V'_z/V_z";
+      fig.histogram = make_histogram(x, lo - pad, hi + pad, 40);
+      const std::string name = "eps_u" + fmt("%.2f", g.lo) + "-" + fmt("%.2f", g.hi) + ".png";
+      write_histogram_png(e.out / name, fig);
+      r.plots.push_back(name);
+    }
+    for (const auto& f : write_bounce_plots(e.out, {r.report.base})) r.plots.push_back(f);
+  }
+  r.seconds_analysis = since(t2);
+  write_file_atomic(e.out / "report.json", to_json(r));
+  write_file_atomic(e.out / "report.txt", format_table(r));
+  return r;
+}
+
+std::string format_table(const MeshBounceReport& r) {
+  const auto& e = r.experiment;
+  const auto& b = r.report;
+  const auto& st = b.stops;
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os << std::setprecision(4);
+  os << "bounce sequences of a rough body: " << r.body_name
+     << (e.mesh.empty() ? "" : e.smooth.empty() ? " (centres on the facets)" : " (centres on the smooth surface)") << ", N = "
+     << e.asperities << ", radii " << e.radii.describe() << ", " << e.bodies << " bodies\n";
+  os << "mass " << r.mass << " kg, principal moments " << r.principal_moments.transpose() << " kg m^2, max |c_i| " << r.c_max
+     << " m\n";
+  os << "first impact u = " << e.options.bounce.speed << " m/s, Omega = " << e.options.omega.transpose() << " rad/s, stop below "
+     << e.options.bounce.stop_speed << " m/s, g = " << e.options.bounce.gravity << " m/s^2\n";
+  os << b.base.sequences << " sequences, " << b.base.impacts << " impacts: " << b.base.impacts_per_sequence << " +- "
+     << b.impacts_per_sequence_sd << " (sd) per sequence, max " << b.impacts_max << "\n";
+ os << "stops: slow " << st.slow << ", no approach " << st.no_approach
+     << ", max impacts " << st.max_impacts << ", max time " << st.max_time << ", max steps " << st.max_steps << "\n";
+  os << "impacts with the centre rising (u <= 0: rocking onto another asperity): " << b.rising_fraction << "\n";
+  os << "eps < 0: " << b.eps_below_0 << ", eps > 1: " << b.eps_above_1 << " (fractions of impacts); <|Omega|> before the last impact "
+     << b.base.spin_final_mean << " rad/s; rotational share of the kinetic energy after the last impact " << b.rot_fraction_last
+     << "\n";
+  os << "energy: impacts gaining energy " << b.energy_gain_fraction << " (max gain " << b.energy_gain_max
+     << " of E), work identity max rel. residual " << b.work_identity_max << ", flight energy max rel. drift " << b.flight_energy_max
+     << "\n";
+  os << "landing search: " << b.queries_per_flight << " support queries per flight, flights < 1 ms: " << b.short_flights << "\n";
+  os << "run " << r.seconds_run << " s (" << static_cast<double>(b.base.sequences) / r.seconds_run << " sequences/s), build "
+     << r.seconds_build << " s, analysis " << r.seconds_analysis << " s\n\n";
+  os << format_bounce_table({b.base});
+  return os.str();
+}
+
+std::string to_json(const MeshBounceReport& r) {
+  const auto& e = r.experiment;
+  const auto& b = r.report;
+  auto jnum = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  // The fig6 report of the same groups and fits (bounce.hpp), with the body in place of the sphere.
+  SphereParams none;
+  none.asperities = e.asperities;
+  nlohmann::json j = nlohmann::json::parse(bounce_to_json(e.scene, none, e.options.bounce, e.seed, {b.base}, r.plots));
+  j["schema_version"] = kReportSchemaVersion;
+  j["scene_file"] = e.scene_file;
+  j["mode"] = "body-bounce";
+  j["parameters"] = {{"asperities", e.asperities}, {"radii", e.radii.describe()}, {"bodies", e.bodies}, {"seed", e.seed}};
+  j["body"] = {{"name", r.body_name},
+               {"mesh", e.mesh.string()},
+               {"scale", e.scale},
+               {"smooth", e.smooth},
+               {"sphere_radius_m", e.mesh.empty() ? jnum(e.sphere_radius) : nlohmann::json(nullptr)},
+               {"mass_kg", r.mass},
+               {"density_kg_m3", e.density},
+               {"principal_moments_kg_m2", {r.principal_moments.x(), r.principal_moments.y(), r.principal_moments.z()}},
+               {"c_max_m", r.c_max}};
+  const auto& st = b.stops;
+  j["bounce"]["omega_rad_s"] = {e.options.omega.x(), e.options.omega.y(), e.options.omega.z()};
+  j["bounce"]["max_time_s"] = e.options.max_time;
+  j["bounce"]["max_impacts"] = e.options.bounce.max_impacts;
+  j["bounce"]["time_tolerance_s"] = e.options.landing.time_tolerance;
+  j["bounce"]["stop_rule"] =
+      "before each impact: total time > max_time; no approach of the lowest asperity; its normal approach speed "
+      "-v_n < stop_speed ('slow'); after impact max_impacts; a landing search > max_steps";
+  j["bounce"]["body"] = {{"stops", {{"slow", st.slow}, {"no_approach", st.no_approach},
+                                    {"max_impacts", st.max_impacts}, {"max_time", st.max_time}, {"max_steps", st.max_steps}}},
+                         {"impacts_per_sequence_sd", b.impacts_per_sequence_sd},
+                         {"impacts_max", b.impacts_max},
+                         {"support_queries_per_flight", jnum(b.queries_per_flight)},
+                         {"rising_fraction", jnum(b.rising_fraction)},
+                         {"eps_below_0_fraction", jnum(b.eps_below_0)},
+                         {"eps_above_1_fraction", jnum(b.eps_above_1)},
+                         {"rotational_share_after_last", jnum(b.rot_fraction_last)},
+                         {"energy_gain_fraction", jnum(b.energy_gain_fraction)},
+                         {"energy_gain_max_rel", jnum(b.energy_gain_max)},
+                         {"work_identity_max_rel", b.work_identity_max},
+                         {"flight_energy_max_rel", b.flight_energy_max},
+                         {"short_flight_fraction", jnum(b.short_flights)},
+                         {"seconds_build", r.seconds_build},
+                         {"seconds_run", r.seconds_run},
+                         {"seconds_analysis", r.seconds_analysis}};
+  return j.dump(2) + "\n";
 }
 
 }  // namespace asperity
