@@ -243,7 +243,22 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
 
 BodyBounceReport analyse_body_bounces(const BodyBounceSamples& s, const BounceExperiment& b, std::uint64_t seed) {
   BodyBounceReport r;
-  r.base = analyse_bounces(s.base, b, seed);
+  {
+    // Eq. 9's eps_n(u) of the speed windows and the lag-1 correlation needs u > 0: impacts with the
+    // centre rising (rocking) have no impact speed and are left out of that analysis only.
+    BounceSamples f;
+    f.variant = s.base.variant, f.sequences = s.base.sequences, f.no_impacts = s.base.no_impacts, f.seconds = s.base.seconds;
+    const auto& B = s.base;
+    for (std::size_t j = 0; j < B.eps.size(); ++j) {
+      if (!(B.speed[j] > 0)) continue;
+      f.sequence.push_back(B.sequence[j]), f.number.push_back(B.number[j]), f.speed.push_back(B.speed[j]);
+      f.eps.push_back(B.eps[j]), f.eps_time.push_back(B.eps_time[j]), f.spin.push_back(B.spin[j]);
+      f.omega_x_after.push_back(B.omega_x_after[j]), f.core.push_back(B.core[j]);
+    }
+    r.base = analyse_bounces(f, b, seed);
+    r.base.impacts = B.eps.size();
+    r.base.impacts_per_sequence = static_cast<double>(B.eps.size()) / static_cast<double>(std::max<std::uint64_t>(1, B.sequences));
+  }
   r.stops = s.stops;
   const auto& B = s.base;
   const std::size_t n = B.eps.size();
@@ -277,6 +292,30 @@ BodyBounceReport analyse_body_bounces(const BodyBounceSamples& s, const BounceEx
   r.rot_fraction_last = last ? rot / last : kNaN;
   r.short_flights = flights ? shortf / flights : kNaN;
   r.energy_gain_fraction = n ? gains / static_cast<double>(n) : kNaN;
+  const int bins = 18;
+  const double lo = b.stop_speed, hi = b.speed;
+  std::vector<std::vector<double>> eb(bins), sb(bins);
+  for (std::size_t j = 0; j < n; ++j) {
+    int k = static_cast<int>((B.speed[j] - lo) / (hi - lo) * bins);
+    if (B.speed[j] == hi) k = bins - 1;
+    if (k < 0 || k >= bins) continue;
+    eb[static_cast<std::size_t>(k)].push_back(B.eps[j]), sb[static_cast<std::size_t>(k)].push_back(B.spin[j]);
+  }
+  for (int k = 0; k < bins; ++k) {
+    auto& v = eb[static_cast<std::size_t>(k)];
+    SpeedBin x;
+    x.lo = lo + k * (hi - lo) / bins, x.hi = lo + (k + 1) * (hi - lo) / bins, x.n = v.size();
+    if (v.size() >= 2) {
+      const Summary su = summarize_iid(v, std::vector<double>{0.1, 0.9});
+      x.eps = su.mean, x.eps_q10 = su.quantiles[0].value, x.eps_q90 = su.quantiles[1].value;
+      double sp = 0;
+      for (double w : sb[static_cast<std::size_t>(k)]) sp += w;
+      x.spin_mean = sp / static_cast<double>(v.size());
+    } else {
+      x.eps = {kNaN, kNaN}, x.eps_q10 = x.eps_q90 = x.spin_mean = kNaN;
+    }
+    r.by_speed.push_back(x);
+  }
   return r;
 }
 
@@ -305,45 +344,27 @@ std::string fmt(const char* f, double x) {
   return buf;
 }
 
-// eps against impact speed: mean +- se and the 10/90% quantiles in speed bins, eps_n(u) of Eq. 9
+// eps against impact speed: mean +- se and the 10/90% quantiles per speed bin, eps_n(u) of Eq. 9
 // (what a smooth sphere would give) for reference.
-void plot_eps_vs_speed(const std::filesystem::path& png, const BodyBounceSamples& s, const BounceExperiment& b,
+void plot_eps_vs_speed(const std::filesystem::path& png, const BodyBounceReport& r, const BounceExperiment& b,
                        const std::string& title) {
-  const auto& B = s.base;
-  const double lo = b.stop_speed, hi = b.speed;
-  const int bins = 18;
-  std::vector<std::vector<double>> by(bins);
-  for (std::size_t j = 0; j < B.eps.size(); ++j) {
-    const int k = static_cast<int>((B.speed[j] - lo) / (hi - lo) * bins);
-    if (k >= 0 && k < bins) by[static_cast<std::size_t>(k)].push_back(B.eps[j]);
-    else if (B.speed[j] == hi) by[bins - 1].push_back(B.eps[j]);
-  }
   const auto en = viscoelastic_pade14(b.beta);
   write_gnuplot_png(png, [&](const std::filesystem::path& out) {
     std::ostringstream o;
     o.imbue(std::locale::classic());
     o.precision(10);
     o << "$m << EOD\n";
-    for (int k = 0; k < bins; ++k) {
-      auto& v = by[static_cast<std::size_t>(k)];
-      if (v.size() < 5) continue;
-      std::sort(v.begin(), v.end());
-      double m = 0, m2 = 0;
-      for (double x : v) m += x;
-      m /= static_cast<double>(v.size());
-      for (double x : v) m2 += (x - m) * (x - m);
-      const double se = std::sqrt(m2 / static_cast<double>(v.size() - 1) / static_cast<double>(v.size()));
-      o << lo + (k + 0.5) * (hi - lo) / bins << ' ' << m << ' ' << se << ' ' << quantile_sorted(v, 0.1) << ' '
-        << quantile_sorted(v, 0.9) << '\n';
-    }
+    for (const auto& x : r.by_speed)
+      if (x.n >= 5)
+        o << 0.5 * (x.lo + x.hi) << ' ' << x.eps.value << ' ' << x.eps.se << ' ' << x.eps_q10 << ' ' << x.eps_q90 << '\n';
     o << "EOD\n$n << EOD\n";
     for (int i = 0; i <= 100; ++i) {
-      const double u = lo + (hi - lo) * i / 100.0;
+      const double u = b.stop_speed + (b.speed - b.stop_speed) * i / 100.0;
       o << u << ' ' << (*en)(u) << '\n';
     }
     o << "EOD\nset encoding utf8\nset terminal pngcairo size 900,600 enhanced font 'sans,12'\nset output '" << out.string()
       << "'\nset title '" << title << "'\nset xlabel 'impact speed u = -V_z [m/s]'\nset ylabel '{/Symbol e} = -V''_z/V_z'\n"
-      << "set key bottom right\nset grid\n"
+      << "set key bottom right\nset grid\nset yrange [-0.5:3]\n"
       << "plot $m using 1:4:5 with filledcurves lc rgb '#cce0f0' title '10%-90% of impacts', \\\n"
       << "  $m using 1:2:3 with yerrorbars pt 7 ps 0.8 lc rgb '#0072B2' title 'mean {/Symbol \\261} se', \\\n"
       << "  $n using 1:2 with lines lw 2 lc rgb '#D55E00' title '{/Symbol e}_n(u), Eq. (9): smooth sphere'\nunset output\n";
@@ -388,8 +409,10 @@ MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e) {
   std::filesystem::create_directories(e.out);
   if (e.plots && plotting_available()) {
     std::ostringstream sub;
-    sub << r.body_name << ", N = " << e.asperities << ", " << e.options.bounce.sequences << " sequences";
-    plot_eps_vs_speed(e.out / "eps_vs_speed.png", S, e.options.bounce, "{/Symbol e} against impact speed: " + sub.str());
+    std::string shown = r.body_name;  // '_' would be a subscript in gnuplot's enhanced text
+    std::replace(shown.begin(), shown.end(), '_', ' ');
+    sub << shown << ", N = " << e.asperities << ", " << e.options.bounce.sequences << " sequences";
+    plot_eps_vs_speed(e.out / "eps_vs_speed.png", r.report, e.options.bounce, "{/Symbol e} against impact speed: " + sub.str());
     r.plots.push_back("eps_vs_speed.png");
     for (const auto& g : r.report.base.groups) {
       if (g.by != "speed" || g.n < 20) continue;
@@ -469,6 +492,10 @@ std::string to_json(const MeshBounceReport& r) {
                {"density_kg_m3", e.density},
                {"principal_moments_kg_m2", {r.principal_moments.x(), r.principal_moments.y(), r.principal_moments.z()}},
                {"c_max_m", r.c_max}};
+  nlohmann::json bins = nlohmann::json::array();
+  for (const auto& x : b.by_speed)
+    bins.push_back({{"range", {x.lo, x.hi}}, {"n", x.n}, {"eps_mean", jnum(x.eps.value)}, {"eps_mean_se", jnum(x.eps.se)},
+                    {"eps_q10", jnum(x.eps_q10)}, {"eps_q90", jnum(x.eps_q90)}, {"spin_mean_rad_s", jnum(x.spin_mean)}});
   const auto& st = b.stops;
   j["bounce"]["omega_rad_s"] = {e.options.omega.x(), e.options.omega.y(), e.options.omega.z()};
   j["bounce"]["max_time_s"] = e.options.max_time;
@@ -491,6 +518,7 @@ std::string to_json(const MeshBounceReport& r) {
                          {"work_identity_max_rel", b.work_identity_max},
                          {"flight_energy_max_rel", b.flight_energy_max},
                          {"short_flight_fraction", jnum(b.short_flights)},
+                         {"eps_by_speed", bins},
                          {"seconds_build", r.seconds_build},
                          {"seconds_run", r.seconds_run},
                          {"seconds_analysis", r.seconds_analysis}};

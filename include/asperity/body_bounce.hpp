@@ -138,8 +138,18 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
                                    int threads = 0,
                                    const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
 
+/// eps and spin in one impact-speed bin.
+struct SpeedBin {
+  double lo = 0, hi = 0;            ///< u range [m/s]
+  std::size_t n = 0;
+  Estimate eps;                     ///< mean eps with iid se
+  double eps_q10 = 0, eps_q90 = 0;  ///< 10% / 90% quantiles of eps
+  double spin_mean = 0;             ///< mean |Omega| before [rad/s]
+};
+
 /// analyse_bounces (bounce.hpp: speed windows, impact numbers, Eq. 2 fits) plus what only bodies have.
 struct BodyBounceReport {
+  std::vector<SpeedBin> by_speed;   ///< 18 equal bins over [stop_speed, speed]
   BounceVariantReport base;
   BodyBounceStops stops;
   double impacts_per_sequence_sd = 0;
