@@ -128,7 +128,8 @@ struct BodyBounceSamples {
   std::vector<double> first_energy;   ///< per sequence: total energy at the first impact [J]
   BodyBounceStops stops;
   std::uint64_t flights = 0, support_queries = 0;
-  double seconds = 0;
+  double seconds = 0;        ///< the sequences (wall)
+  double seconds_index = 0;  ///< building the K support trees (wall)
 };
 
 /// Runs o.bounce.sequences sequences over `bodies` (sequence s uses bodies[s % K]); each body's
@@ -203,7 +204,7 @@ struct MeshBounceReport {
   double c_max = 0;                      ///< max |c_i| over the bodies [m]
   BodyBounceReport report;
   std::vector<std::string> plots;
-  double seconds_build = 0, seconds_run = 0, seconds_analysis = 0;
+  double seconds_build = 0, seconds_index = 0, seconds_run = 0, seconds_analysis = 0;  ///< bodies, trees, sequences, analysis
 };
 
 MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e);
