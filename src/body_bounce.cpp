@@ -475,6 +475,14 @@ std::string format_table(const MeshBounceReport& r) {
   os << "landing search: " << b.queries_per_flight << " support queries per flight, flights < 1 ms: " << b.short_flights << "\n";
   os << "run " << r.seconds_run << " s (" << static_cast<double>(b.base.sequences) / r.seconds_run << " sequences/s), bodies "
      << r.seconds_build << " s, support trees " << r.seconds_index << " s, analysis " << r.seconds_analysis << " s\n\n";
+  os << "u bin [m/s]        n   <eps> +- se          eps 10% .. 90%     <|Omega|> [rad/s]\n";
+  for (const auto& x : b.by_speed) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%.3f-%.3f %7zu   %8.4f +- %-8.4f  %7.3f .. %-7.3f  %8.2f\n", x.lo, x.hi, x.n, x.eps.value,
+                  x.eps.se, x.eps_q10, x.eps_q90, x.spin_mean);
+    os << line;
+  }
+  os << "\n";
   os << format_bounce_table({b.base});
   return os.str();
 }
