@@ -17,6 +17,7 @@
 #include "asperity/body_bounce.hpp"
 #include "asperity/body_experiments.hpp"
 #include "asperity/mesh.hpp"
+#include "asperity/report.hpp"
 #include "asperity/random.hpp"
 #include "asperity/support.hpp"
 
@@ -104,6 +105,18 @@ void support_bench(const std::vector<std::uint64_t>& ns, std::uint64_t queries, 
               << med(build) << " | " << static_cast<double>(q->memory_bytes()) / 1e6 << " |\n";
     if (sink == 42) std::cout << "";
   }
+}
+
+// report.json (with the common header, tool "rough_bodies") and report.txt into `dir`, through
+// the same writer as validate-geometry.
+void write_driver_report(const std::filesystem::path& dir, const std::string& what, const std::string& body,
+                         const std::string& table) {
+  std::filesystem::create_directories(dir);
+  ReportHeader h;
+  h.tool = "rough_bodies";
+  h.scene = what;
+  write_report_files(dir, "report.json", with_header(body, h), table);
+  std::cout << "wrote " << (dir / "report.json").string() << ", report.txt\n";
 }
 
 }  // namespace
@@ -212,6 +225,7 @@ int main(int argc, char** argv) {
       re.plots = !no_plots;
       const RadiiReport r = run_radii_experiment(re);
       std::cout << format_table(r);
+      write_driver_report(re.out, "radii", to_json(r), format_table(r));
       return 0;
     }
     if (*mesh) {
@@ -221,6 +235,7 @@ int main(int argc, char** argv) {
       me.plots = !mesh_no_plots;
       const MeshImpactReport r = run_mesh_impacts(me);
       std::cout << format_table(r);
+      write_driver_report(me.out, "mesh", to_json(r), format_table(r));
       return 0;
     }
     if (*bounce) {

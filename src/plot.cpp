@@ -267,29 +267,45 @@ std::string build_script(const HistogramFigure& fig, const fs::path& out) {
 
 }  // namespace
 
+Curve sampled_curve(const std::function<double(double)>& f, std::string label, double lo, double hi, int segments) {
+  Curve c;
+  c.label = std::move(label);
+  for (int i = 0; i <= segments; ++i) {
+    const double t = lo + (hi - lo) * i / static_cast<double>(segments);
+    const double y = f(t);
+    c.x.push_back(t);
+    c.y.push_back(std::isfinite(y) ? y : 0.0);
+  }
+  return c;
+}
+
 bool plotting_available() {
   return run_ok("gnuplot -e \"set terminal pngcairo\" >/dev/null 2>&1 </dev/null");
 }
 
-void write_histogram_png(const fs::path& png, const HistogramFigure& fig) {
-  if (png.empty()) throw std::invalid_argument("write_histogram_png: empty output path");
-  if (!png.has_filename()) throw std::invalid_argument("write_histogram_png: output path has no file name");
-  validate(fig);
+namespace {
 
+// Renders the script `script_for(out)` with gnuplot into `png`: script and gnuplot's stderr in a
+// private temporary directory, the image beside the target, renamed onto it only on success.
+// `who` prefixes every message.
+void run_gnuplot(const char* who, const fs::path& png, const std::function<std::string(const fs::path& out)>& script_for) {
+  const std::string w = who;
+  if (png.empty()) throw std::invalid_argument(w + ": empty output path");
+  if (!png.has_filename()) throw std::invalid_argument(w + ": output path has no file name");
   const std::string suffix = random_suffix();
   Cleanup cleanup;
 
   // Private work directory for script and gnuplot's stderr.
   std::error_code ec;
   const fs::path tmp_root = fs::temp_directory_path(ec);
-  if (ec) throw std::runtime_error("write_histogram_png: no temporary directory: " + ec.message());
+  if (ec) throw std::runtime_error(w + ": no temporary directory: " + ec.message());
   std::string stem = png.stem().string();
   for (char& c : stem)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
   if (stem.size() > 64) stem.resize(64);
   const fs::path work = tmp_root / ("asperity-plot-" + stem + "-" + suffix);
   if (!fs::create_directory(work, ec) || ec)
-    throw std::runtime_error("write_histogram_png: cannot create " + work.string() +
+    throw std::runtime_error(w + ": cannot create " + work.string() +
                              (ec ? ": " + ec.message() : std::string(": already exists")));
   cleanup.paths.push_back(work);
 
@@ -300,11 +316,11 @@ void write_histogram_png(const fs::path& png, const HistogramFigure& fig) {
   const fs::path script = work / "figure.gp";
   const fs::path err = work / "gnuplot.err";
   {
-    const std::string text = build_script(fig, out);
+    const std::string text = script_for(out);
     std::ofstream f(script, std::ios::binary);
     f << text;
     f.close();
-    if (!f) throw std::runtime_error("write_histogram_png: cannot write " + script.string());
+    if (!f) throw std::runtime_error(w + ": cannot write " + script.string());
   }
 
   const std::string cmd =
@@ -312,43 +328,28 @@ void write_histogram_png(const fs::path& png, const HistogramFigure& fig) {
   const bool ok = run_ok(cmd);
   const std::string messages = read_file_text(err);
   if (!ok)
-    throw std::runtime_error("write_histogram_png: gnuplot failed writing " + png.string() +
+    throw std::runtime_error(w + ": gnuplot failed writing " + png.string() +
                              (messages.empty() ? std::string(" (no message; is gnuplot installed?)")
                                                : ":\n" + messages));
   if (!fs::is_regular_file(out, ec) || fs::file_size(out, ec) == 0 || ec)
-    throw std::runtime_error("write_histogram_png: gnuplot produced no output for " + png.string() +
+    throw std::runtime_error(w + ": gnuplot produced no output for " + png.string() +
                              (messages.empty() ? std::string() : ":\n" + messages));
 
   fs::rename(out, png, ec);
-  if (ec)
-    throw std::runtime_error("write_histogram_png: cannot rename onto " + png.string() + ": " + ec.message());
+  if (ec) throw std::runtime_error(w + ": cannot rename onto " + png.string() + ": " + ec.message());
+}
+
+}  // namespace
+
+void write_histogram_png(const fs::path& png, const HistogramFigure& fig) {
+  if (png.empty()) throw std::invalid_argument("write_histogram_png: empty output path");
+  if (!png.has_filename()) throw std::invalid_argument("write_histogram_png: output path has no file name");
+  validate(fig);
+  run_gnuplot("write_histogram_png", png, [&](const fs::path& out) { return build_script(fig, out); });
 }
 
 void write_gnuplot_png(const fs::path& png, const std::function<std::string(const fs::path& out)>& script_for) {
-  if (png.empty() || !png.has_filename()) throw std::invalid_argument("write_gnuplot_png: output path has no file name");
-  const std::string suffix = random_suffix();
-  Cleanup cleanup;
-  std::error_code ec;
-  const fs::path tmp_root = fs::temp_directory_path(ec);
-  if (ec) throw std::runtime_error("write_gnuplot_png: no temporary directory: " + ec.message());
-  const fs::path work = tmp_root / ("asperity-plot-gp-" + suffix);
-  if (!fs::create_directory(work, ec) || ec) throw std::runtime_error("write_gnuplot_png: cannot create " + work.string());
-  cleanup.paths.push_back(work);
-  const fs::path out = png.parent_path() / (png.filename().string() + "." + suffix + ".tmp");
-  cleanup.paths.push_back(out);
-  const fs::path script = work / "figure.gp", err = work / "gnuplot.err";
-  {
-    std::ofstream f(script, std::ios::binary);
-    f << script_for(out);
-    f.close();
-    if (!f) throw std::runtime_error("write_gnuplot_png: cannot write " + script.string());
-  }
-  const bool ok = run_ok("gnuplot " + shell_quote(script.string()) + " </dev/null >/dev/null 2>" + shell_quote(err.string()));
-  const std::string messages = read_file_text(err);
-  if (!ok || !fs::is_regular_file(out, ec) || fs::file_size(out, ec) == 0)
-    throw std::runtime_error("write_gnuplot_png: gnuplot failed writing " + png.string() + (messages.empty() ? "" : ":\n" + messages));
-  fs::rename(out, png, ec);
-  if (ec) throw std::runtime_error("write_gnuplot_png: cannot rename onto " + png.string() + ": " + ec.message());
+  run_gnuplot("write_gnuplot_png", png, script_for);
 }
 
 }  // namespace asperity

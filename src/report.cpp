@@ -84,11 +84,27 @@ ImpactScene impact_scene(const EnsembleConfig& e) {
   return x;
 }
 
+// A law the run should have tested but could not: reported with verdict "skipped".
+struct SkippedLaw {
+  std::string quantity, law;
+  bool decisive = false;
+  std::string reason;
+};
+
+// The Sec. IV laws by name, as laws_for builds them (decisive: the corrected ones).
+std::vector<SkippedLaw> sec4_laws(const std::string& reason) {
+  return {{"eps", "eq28-printed", false, reason},        {"eps", "eq28-paper-route", false, reason},
+          {"eps", "eq28-corrected", true, reason},       {"omega_x_after", "eq33-printed", false, reason},
+          {"omega_x_after", "eq33-corrected", true, reason}};
+}
+
 // The laws of the requested outputs only: contact laws if `contact`, impact laws if the
 // experiment has impacts (the planner turns impacts off when restitution is not requested).
 // `impact_laws`: the Sec. IV laws describe every drop; when some drops did not impact, the eps
-// sample is truncated and those laws do not apply. `note` collects laws that were not tested.
-std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact, bool impact_laws, std::string& note) {
+// sample is truncated and those laws do not apply. `note` collects laws that were not tested,
+// `skipped` lists them.
+std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact, bool impact_laws, std::string& note,
+                             std::vector<SkippedLaw>* skipped = nullptr) {
   const auto& p = e.sphere;
   const double R = p.radius;
   const auto n = p.asperities;
@@ -103,6 +119,7 @@ std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact, bool impact_
   if (e.impact.enabled && !impact_laws) {
     note = " Sec. IV laws not tested: some drops did not impact (contact point not approaching the plate), so the "
            "eps and Omega'_x samples are truncated.";
+    if (skipped) *skipped = sec4_laws("some drops did not impact: the eps and Omega'_x samples are truncated");
   } else if (e.impact.enabled && e.impact.eps_t == 1.0 && e.impact.omega.z() == 0.0) {
     ImpactScene x = impact_scene(e);
     ImpactScene physical = x;
@@ -119,6 +136,7 @@ std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact, bool impact_
       sets.push_back(std::move(wx));
     } catch (const std::exception& ex) {
       note = std::string(" Sec. IV laws not tested: they cannot be evaluated at these parameters (") + ex.what() + ").";
+      if (skipped) *skipped = sec4_laws(std::string("cannot be evaluated at these parameters: ") + ex.what());
     }
   }
   return sets;
@@ -148,10 +166,30 @@ std::string fmt(double v, int prec = 4) {
   return os.str();
 }
 
+nlohmann::json plan_json(const std::vector<PlanStage>& plan) {
+  using nlohmann::json;
+  json out = json::array();
+  for (const auto& st : plan)
+    out.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
+                   {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
+  return out;
+}
+
+nlohmann::json timings_json(const std::vector<std::pair<std::string, double>>& timings) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [k, v] : timings) out[k] = v;
+  return out;
+}
+
 }  // namespace
 
 bool GeometryReport::rejected() const {
   return std::any_of(tests.begin(), tests.end(), [](const TestReport& t) { return t.decisive && t.verdict == "reject"; });
+}
+
+std::size_t GeometryReport::skipped() const {
+  return static_cast<std::size_t>(
+      std::count_if(tests.begin(), tests.end(), [](const TestReport& t) { return t.decisive && t.verdict == "skipped"; }));
 }
 
 GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
@@ -214,8 +252,19 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
 
   std::string law_note;
   const bool impact_laws = s.no_impacts == 0 && s.eps.size() == n;
-  const auto law_sets = laws_for(scene.ensemble, scene.contact_stats, impact_laws, law_note);
+  std::vector<SkippedLaw> skipped;
+  const auto law_sets = laws_for(scene.ensemble, scene.contact_stats, impact_laws, law_note, &skipped);
   r.ensemble_note += law_note;
+  // A law that cannot be evaluated is listed with verdict "skipped" (p and D null): in fixed mode
+  // as the pooled test and as the decisive one-per-sphere test it would have had.
+  const auto skip = [&](const std::string& quantity, const std::string& law, bool decisive_law, std::size_t count,
+                        const std::string& reason) {
+    const std::string note = "not tested: " + reason;
+    r.tests.push_back({quantity, law, fixed ? "pooled" : "all", "KS", kNaN, kNaN, count, kNaN, !fixed,
+                       !fixed && decisive_law, "skipped", note});
+    if (fixed)
+      r.tests.push_back({quantity, law, "one-per-sphere", "KS", kNaN, kNaN, K, kNaN, true, decisive_law, "skipped", note});
+  };
   for (const auto& set : law_sets) {
     const auto& x = column(s, set.quantity);
     if (x.empty()) continue;
@@ -245,6 +294,8 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
         // Only the Sec. IV laws can fail here, far outside the paper's regime: say so, test the rest.
         r.ensemble_note += " Law " + law.name + " not tested: it cannot be evaluated at these parameters (" +
                            ex.what() + ").";
+        skip(set.quantity, law.name, decisive_law, x.size(),
+             std::string("cannot be evaluated at these parameters: ") + ex.what());
         continue;
       }
       if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
@@ -266,8 +317,15 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
         r.tests.push_back(t);
         if (first.empty()) continue;
         // The decisive test: one rotation per sphere gives K iid draws of the ensemble law.
-        const auto ks1 = atom ? ks_mixed(first, first_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
-                              : ks_one_sample(sorted(first), law.cdf);
+        KsResult ks1;
+        try {
+          ks1 = atom ? ks_mixed(first, first_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
+                     : ks_one_sample(sorted(first), law.cdf);
+        } catch (const std::exception& ex) {
+          r.tests.push_back({set.quantity, law.name, "one-per-sphere", "KS", kNaN, kNaN, K, mean, true, decisive_law,
+                             "skipped", std::string("not tested: cannot be evaluated at these parameters: ") + ex.what()});
+          continue;
+        }
         TestReport t1{set.quantity, law.name, "one-per-sphere", "KS", ks1.D, ks1.p, K, mean, true, decisive_law,
                       ks1.p < scene.alpha ? "reject" : "accept", "first rotation of each sphere: iid"};
         r.tests.push_back(t1);
@@ -276,6 +334,8 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
       r.tests.push_back(t);
     }
   }
+
+  for (const auto& l : skipped) skip(l.quantity, l.law, l.decisive, column(s, l.quantity).size(), l.reason);
 
   if (scene.contact_stats) {
     // Core contacts: binomial(drops, P_core) for fresh spheres; two-sided exact p-value.
@@ -336,7 +396,13 @@ std::string format_table(const GeometryReport& r) {
   }
   os << "runner-up gap: min " << fmt(r.gap_min * 1e9, 4) << " nm, median " << fmt(r.gap_median * 1e9, 4) << " nm\n";
   os << r.ensemble_note << "\n";
-  os << "verdict: " << (r.rejected() ? "a law was REJECTED" : "no law rejected") << "\n";
+  os << "verdict: " << (r.rejected() ? "a law was REJECTED" : "no law rejected");
+  if (const std::size_t k = r.skipped(); k > 0)
+    os << "; " << k << " decisive test" << (k == 1 ? "" : "s") << " SKIPPED (could not be evaluated, see the notes)";
+  os << "\n";
+  for (const auto& t : r.tests)  // the rows show the others
+    if (t.decisive && t.verdict == "skipped")
+      os << "skipped: " << t.quantity << " " << t.law << " (" << t.scope << "): " << t.note << "\n";
   return os.str();
 }
 
@@ -393,7 +459,7 @@ std::string to_json(const GeometryReport& r) {
                      {"scope", t.scope},
                      {"statistic", t.statistic},
                      {"D", std::isnan(t.D) ? json(nullptr) : json(t.D)},
-                     {"p", t.p},
+                     {"p", std::isnan(t.p) ? json(nullptr) : json(t.p)},
                      {"n", t.n},
                      {"predicted_mean", t.predicted_mean},
                      {"iid", t.iid},
@@ -403,18 +469,11 @@ std::string to_json(const GeometryReport& r) {
   }
   j["tests"] = tests;
   j["rejected"] = r.rejected();
-  json tm = json::object();
-  for (const auto& [k, v] : r.timings_s) tm[k] = v;
-  j["timings_s"] = tm;
+  j["skipped"] = r.skipped();
+  j["timings_s"] = timings_json(r.timings_s);
   if (r.index_bytes) j["index_bytes_per_asperity"] = double(r.index_bytes) / double(e.sphere.asperities);
   j["plots"] = r.plots;
-  if (!r.plan.empty()) {
-    json plan = json::array();
-    for (const auto& st : r.plan)
-      plan.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
-                      {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
-    j["plan"] = plan;
-  }
+  if (!r.plan.empty()) j["plan"] = plan_json(r.plan);
   if (!r.scene_toml.empty()) j["scene_file"] = r.scene_toml;
   return j.dump(2) + "\n";
 }
@@ -439,6 +498,36 @@ void write_file_atomic(const std::filesystem::path& file, const std::string& tex
     std::filesystem::remove(tmp, ec);
     throw std::runtime_error("cannot write " + file.string() + ": " + ec.message());
   }
+}
+
+std::string with_header(const std::string& body, const ReportHeader& h) {
+  using nlohmann::json;
+  json j = json::parse(body);
+  if (!j.is_object()) throw std::invalid_argument("with_header: the report body must be a JSON object");
+  j["schema_version"] = kReportSchemaVersion;
+  j["tool"] = h.tool;
+  j["scene"] = h.scene;
+  if (!h.scene_toml.empty()) j["scene_file"] = h.scene_toml;
+  if (!h.plan.empty()) j["plan"] = plan_json(h.plan);
+  if (!h.timings_s.empty()) j["timings_s"] = timings_json(h.timings_s);
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::filesystem::path> write_report_files(const std::filesystem::path& dir, const std::string& report_name,
+                                                      const std::string& json, const std::string& table) {
+  const std::filesystem::path report = dir / report_name;
+  std::filesystem::path txt = report;
+  txt.replace_extension(".txt");
+  if (txt == report) txt += ".txt";  // a report named "x.txt" keeps its table apart
+  write_file_atomic(report, json);
+  try {
+    write_file_atomic(txt, table);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(report, ec);
+    throw;
+  }
+  return {report, txt};
 }
 
 std::vector<std::string> write_plots(const std::filesystem::path& dir, const Scene& scene, const ContactSamples& s) {
@@ -479,18 +568,11 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
     }
     fig.histogram = make_histogram(x, lo, hi, 60);
     for (const auto& law : set.laws) {
-      Curve c;
-      c.label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
-                : law.name == "eq18" ? "Eq. (18), Gaussian"
-                : law.name == "exact-sphere" ? "exact finite-N law on the sphere"
-                                             : law.name;
-      for (int i = 0; i <= 300; ++i) {
-        const double t = lo + (hi - lo) * i / 300.0;
-        const double y = law.pdf(t);
-        c.x.push_back(t);
-        c.y.push_back(std::isfinite(y) ? y : 0.0);
-      }
-      fig.curves.push_back(std::move(c));
+      const std::string label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
+                                : law.name == "eq18" ? "Eq. (18), Gaussian"
+                                : law.name == "exact-sphere" ? "exact finite-N law on the sphere"
+                                                             : law.name;
+      fig.curves.push_back(sampled_curve(law.pdf, label, lo, hi));
     }
     const std::string name = set.quantity + ".png";
     write_histogram_png(dir / name, fig);

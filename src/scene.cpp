@@ -1,9 +1,11 @@
 #include "asperity/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "asperity/scene_file.hpp"
+#include "format.hpp"
 #include "asperity_embedded_scenes.hpp"  // generated from scenes/*.toml (CMakeLists.txt)
 
 namespace asperity {
@@ -46,6 +48,14 @@ void validate(const Scene& s) {
     if (!s.ensemble.impact.enabled || s.bounce.enabled)
       throw std::invalid_argument("a mesh body runs single impacts: it needs an impact experiment");
   } else if (s.radii) {
+    // As the scene file checks it, also after --radius: every level (the lognormal median) below R.
+    const auto& d = s.radii->radii;
+    const double R = s.ensemble.sphere.radius;
+    const double top = d.kind == RadiusDistribution::Kind::levels
+                           ? *std::max_element(d.levels.begin(), d.levels.end())
+                           : d.kind == RadiusDistribution::Kind::lognormal ? d.median : d.radius;
+    if (!(top < R))
+      throw std::invalid_argument("asperity radii " + d.describe() + " must be smaller than radius = " + detail::num(R) + " m");
     if (s.ensemble.mode != Mode::fresh)
       throw std::invalid_argument("unequal asperity radii on a sphere need mode fresh, got " +
                                   std::string(to_string(s.ensemble.mode)));

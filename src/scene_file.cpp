@@ -492,8 +492,6 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     if (auto r = out->text("report")) {
       if (r->find('/') != std::string::npos || *r == "." || *r == "..")
         out->bad("report", "must be a file name inside outputs.dir, got " + quote(*r));
-      if ((s.mesh || s.radii) && *r != "report.json")
-        out->bad("report", "mesh bodies and unequal radii always write report.json, got " + quote(*r));
       s.report = *r;
     }
     if (auto p = out->text("export_ply")) {

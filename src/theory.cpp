@@ -3,7 +3,7 @@
 #include <cmath>
 // Boost 1.74's pchip calls isnan unqualified from a template; make it visible (fixed upstream later).
 using std::isnan;
-#include <boost/math/interpolators/pchip.hpp>
+#include "theory_detail.hpp"
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <boost/math/special_functions/erf.hpp>
 
@@ -82,14 +82,9 @@ Law exact_sphere_rxy(std::uint64_t n, double R) {
 Law eq18_rx(std::uint64_t n, double R, double scale) {
   check(n, R);
   const double sigma = scale / std::sqrt(2.0 * pi * areal_density(n, R));
-  Law law;
+  Law law = detail::centred_gaussian(sigma);
   law.name = scale == 1.0 ? "eq18" : "eq18-x" + std::to_string(scale);
   law.description = "Eq. 18: Gaussian, p(t) = sqrt(lambda) exp(-pi lambda t^2)";
-  law.cdf = [sigma](double t) { return 0.5 * boost::math::erfc(-t / (sigma * std::numbers::sqrt2)); };
-  law.pdf = [sigma](double t) {
-    const double z = t / sigma;
-    return std::exp(-0.5 * z * z) / (sigma * std::sqrt(2.0 * pi));
-  };
   return law;
 }
 
@@ -124,14 +119,7 @@ Law exact_sphere_rx(std::uint64_t n, double R) {
   // large N) but never beyond R. Outside the table the quadrature is used directly.
   const double sigma = 1.0 / std::sqrt(2.0 * pi * areal_density(n, R));
   const double t_max = std::min(R, 12.0 * sigma);
-  constexpr int nodes = 3001;
-  std::vector<double> ts(nodes), tails(nodes);
-  for (int i = 0; i < nodes; ++i) {
-    ts[i] = t_max * i / (nodes - 1);
-    tails[i] = rx_tail(e, ts[i]);
-  }
-  // pchip keeps the interpolant monotone, so the tabulated cdf stays a cdf.
-  auto table = std::make_shared<boost::math::interpolators::pchip<std::vector<double>>>(std::move(ts), std::move(tails));
+  const auto table = detail::tabulate_tail(t_max, 3001, [&](double t) { return rx_tail(e, t); });
   Law law;
   law.name = "exact-sphere";
   law.description = "exact finite-N law of r_x = r_xy cos(phi) on the sphere (quadrature)";

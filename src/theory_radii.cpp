@@ -3,7 +3,7 @@
 #include <cmath>
 // Boost 1.74's pchip calls isnan unqualified from a template; make it visible (fixed upstream later).
 using std::isnan;
-#include <boost/math/interpolators/pchip.hpp>
+#include "theory_detail.hpp"
 #include <boost/math/quadrature/gauss_kronrod.hpp>
 #include <boost/math/special_functions/erf.hpp>
 
@@ -157,13 +157,7 @@ Law levels_sphere_rx(std::uint64_t n, double R, const RadiusDistribution& d, dou
   for (double f : l.f) fmin = std::min(fmin, f);
   const double lam = static_cast<double>(n) * fmin / (4.0 * pi * R * R);
   const double t_max = std::min(R, 12.0 / std::sqrt(2.0 * pi * lam));
-  constexpr int nodes = 801;
-  std::vector<double> ts(nodes), tails(nodes);
-  for (int i = 0; i < nodes; ++i) {
-    ts[i] = t_max * i / (nodes - 1);
-    tails[i] = rx_tail(e, ts[i]);
-  }
-  auto table = std::make_shared<boost::math::interpolators::pchip<std::vector<double>>>(std::move(ts), std::move(tails));
+  const auto table = detail::tabulate_tail(t_max, 801, [&](double t) { return rx_tail(e, t); });
   Law law;
   law.name = scale == 1.0 ? "exact-levels" : "exact-levels-x" + detail::num(scale);
   law.description = "exact finite-N law of r_x with level radii " + d.describe() + " (quadrature)";
@@ -183,14 +177,9 @@ Law gaussian_rx(double lambda, std::string name) {
   if (!(lambda > 0) || !std::isfinite(lambda))
     throw std::invalid_argument("areal density must be finite and > 0, got " + detail::num(lambda));
   const double sigma = 1.0 / std::sqrt(2.0 * pi * lambda);
-  Law law;
+  Law law = detail::centred_gaussian(sigma);
   law.name = std::move(name);
   law.description = "Gaussian, sigma^2 = 1/(2 pi lambda), lambda = " + detail::num(lambda) + " 1/m^2";
-  law.cdf = [sigma](double t) { return 0.5 * boost::math::erfc(-t / (sigma * std::numbers::sqrt2)); };
-  law.pdf = [sigma](double t) {
-    const double z = t / sigma;
-    return std::exp(-0.5 * z * z) / (sigma * std::sqrt(2.0 * pi));
-  };
   return law;
 }
 

@@ -12,6 +12,8 @@
 #include <set>
 #include <string>
 
+#include "asperity/scene_file.hpp"
+#include "cli/progress_line.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
@@ -22,6 +24,11 @@ using CliRun = asperity::testing::CommandResult;
 
 CliRun run(const std::string& args) {
   return asperity::testing::run_command(std::string(VALIDATE_GEOMETRY) + " -q " + args + " 2>&1");
+}
+
+std::string slurp_file(const fs::path& file) {
+  std::ifstream f(file);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
 }
 
 fs::path fresh_dir(const std::string& name) {
@@ -95,8 +102,10 @@ TEST(Cli, GoodRunWritesTheReportContract) {
   }
   EXPECT_TRUE(laws.count("eq14") && laws.count("eq18") && laws.count("exact-sphere"));
   for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
-  // No temporary files are left next to the report.
-  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().filename(), "report.json");
+  // No temporary files are left next to the report and its table.
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_TRUE(e.path().filename() == "report.json" || e.path().filename() == "report.txt") << e.path();
+  EXPECT_NE(slurp_file(out / "report.txt").find("verdict"), std::string::npos);
   fs::remove_all(out);
 }
 
@@ -154,7 +163,8 @@ TEST(CliScene, ATinySceneWritesAReportWithItsPlan) {
   EXPECT_EQ(skipped, (std::set<std::string>{"generate", "index", "impact", "plots"}));
   for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
   EXPECT_NE(j.at("scene_file").get<std::string>().find("count = 500"), std::string::npos);
-  for (const auto& e : fs::directory_iterator(out)) EXPECT_EQ(e.path().filename(), "tiny.json");
+  for (const auto& e : fs::directory_iterator(out))  // the table is named after the report
+    EXPECT_TRUE(e.path().filename() == "tiny.json" || e.path().filename() == "tiny.txt") << e.path();
   fs::remove_all(out);
   fs::remove(scene);
 }
@@ -268,3 +278,253 @@ TEST(CliScene, MeshSceneRunsMeshImpactsAndExportsPly) {
   fs::remove(scene);
   fs::remove(bad);
 }
+
+namespace {
+
+// Every kind of run has the common header, and scene_file is the effective scene: it parses, and
+// writes back to the same text.
+void expect_common_header(const nlohmann::json& j, const std::string& scene) {
+  EXPECT_EQ(j.at("schema_version"), 1) << j.dump(1);
+  EXPECT_EQ(j.at("tool"), "validate-geometry");
+  EXPECT_EQ(j.at("scene"), scene);
+  const std::string toml = j.at("scene_file").get<std::string>();
+  const asperity::Scene s = asperity::parse_scene(toml, "report scene_file");
+  EXPECT_EQ(asperity::to_toml(s), toml);
+  EXPECT_EQ(s.name, scene);
+  ASSERT_TRUE(j.at("plan").is_array());
+  EXPECT_FALSE(j.at("plan").empty());
+  for (const auto& st : j.at("plan")) {
+    EXPECT_FALSE(st.at("reason").get<std::string>().empty());
+    if (st.at("run").get<bool>()) {
+      EXPECT_GE(st.at("seconds").get<double>(), 0.0);
+      EXPECT_TRUE(j.at("timings_s").contains(st.at("stage").get<std::string>())) << st.dump();
+    } else {
+      EXPECT_TRUE(st.at("seconds").is_null());
+    }
+  }
+}
+
+const char* kLevels = "radius = { distribution = \"levels\", radii = [1.3e-6, 6.5e-7], fractions = [0.2, 0.8] }\n";
+
+fs::path levels_scene(const fs::path& out, const std::string& extra_asperities = kLevels) {
+  return write_scene("lv-hdr", "format = 1\nname = \"lv\"\n[asperities]\ncount = 2000\n" + extra_asperities +
+                                   "[screening]\nbodies = 2\ndirections = 1000\n[ensemble]\ndrops = 3000\nseed = 3\n"
+                                   "[outputs]\nplots = false\ndir = \"" + out.string() + "\"\n");
+}
+
+fs::path mesh_scene(const fs::path& out, const std::string& extra_asperities = kLevels) {
+  const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
+  return write_scene("mesh-hdr", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
+                                     "\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[asperities]\ncount = 2000\n" + extra_asperities +
+                                     "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 200\n"
+                                     "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n"
+                                     "[outputs]\nplots = false\ndir = \"" + out.string() + "\"\n");
+}
+
+TEST(CliReport, RadiiAndMeshRunsHaveTheCommonHeader) {
+  const fs::path out = fresh_dir("hdr");
+  for (const auto& [scene, name] : {std::pair{levels_scene(out), "lv"}, std::pair{mesh_scene(out), "m"}}) {
+    const CliRun r = run("--scene " + scene.string());
+    ASSERT_EQ(r.status, 0) << r.out;
+    const auto j = read_report(out / "report.json");
+    expect_common_header(j, name);
+    EXPECT_TRUE(j.contains("experiment"));  // the fields of before stay
+    EXPECT_TRUE(j.at("rejected").is_boolean());
+    EXPECT_FALSE(slurp_file(out / "report.txt").empty());
+    fs::remove_all(out);
+    fs::remove(scene);
+  }
+  // The paper's sphere and the bounce run: the same header.
+  CliRun r = run("--asperities 500 --drops 2000 --no-plots --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  expect_common_header(read_report(out / "report.json"), "fig3+custom");
+  fs::remove_all(out);
+  r = run("--preset fig6 --sequences 10 --variant paper --asperities 1e4 --no-plots --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  expect_common_header(read_report(out / "report.json"), "fig6+custom");
+  EXPECT_TRUE(fs::exists(out / "report.txt"));
+  fs::remove_all(out);
+}
+
+// Options override the file: --asperity-radius replaces level radii by fixed ones. On a sphere the
+// run becomes the paper's; on a mesh it stays a mesh run. The effective scene shows it.
+TEST(CliReport, AsperityRadiusOverridesLevelRadii) {
+  const fs::path out = fresh_dir("arad");
+  const fs::path lv = levels_scene(out);
+  CliRun r = run("--scene " + lv.string() + " --asperity-radius 1e-6");
+  ASSERT_EQ(r.status, 0) << r.out;
+  auto j = read_report(out / "report.json");
+  expect_common_header(j, "lv+custom");
+  EXPECT_FALSE(j.contains("experiment")) << "a sphere with fixed radii is the paper's run";
+  EXPECT_EQ(j.at("parameters").at("asperity_radius_m"), 1e-6);
+  EXPECT_NE(j.at("scene_file").get<std::string>().find("distribution = \"fixed\", value = 1e-06"), std::string::npos);
+  EXPECT_EQ(j.at("scene_file").get<std::string>().find("levels"), std::string::npos);
+  fs::remove_all(out);
+  const fs::path mesh = mesh_scene(out);
+  r = run("--scene " + mesh.string() + " --asperity-radius 1e-6");
+  ASSERT_EQ(r.status, 0) << r.out;
+  j = read_report(out / "report.json");
+  expect_common_header(j, "m+custom");
+  EXPECT_EQ(j.at("experiment"), "mesh-impacts");
+  EXPECT_EQ(j.at("radii"), "fixed(1e-06)");
+  EXPECT_NE(j.at("scene_file").get<std::string>().find("distribution = \"fixed\", value = 1e-06"), std::string::npos);
+  fs::remove_all(out);
+  // Lognormal radii too.
+  const fs::path ln = levels_scene(out, "radius = { distribution = \"lognormal\", median = 6.5e-7, sigma = 0.5 }\n");
+  r = run("--scene " + ln.string() + " --asperity-radius 1e-6");
+  ASSERT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(read_report(out / "report.json").at("parameters").at("asperity_radius_m"), 1e-6);
+  fs::remove_all(out);
+  for (const auto& f : {lv, mesh, ln}) fs::remove(f);
+}
+
+// An option that cannot apply to the scene's kind of run is an error naming the option and why,
+// with exit status 2 and nothing written; never silently ignored.
+TEST(CliReport, OptionsThatCannotApplyAreErrors) {
+  const fs::path out = fresh_dir("noapply");
+  const fs::path lv = levels_scene(out), mesh = mesh_scene(out);
+  const std::string L = "--scene " + lv.string(), M = "--scene " + mesh.string();
+  const std::vector<Bad> cases = {
+      {"--backend grid", "--backend: only for fixed mode"},
+      {"--spheres 4", "--spheres: only for fixed mode"},
+      {"--preset fig6 --drops 100", "--drops: not used by a bounce run"},
+      {"--preset fig6 --mode fixed", "--mode: not used by a bounce run"},
+      {"--preset fig6 --alpha 0.05", "--alpha: not used by a bounce run"},
+      {"--preset fig6 --omega-x 1", "--omega-x: not used by a bounce run"},
+      {"--preset fig6 --spheres 2", "--spheres: not used by a bounce run"},
+      {"--preset fig6 --backend grid", "--backend: not used by a bounce run"},
+      {L + " --mode fixed", "--mode: 'fixed'"},
+      {L + " --speed 1", "--speed"},
+      {L + " --omega-y 1", "--omega-y"},
+      {L + " --backend grid", "--backend: not used by a run with unequal asperity radii"},
+      {L + " --spheres 3", "--spheres: not used by a run with unequal asperity radii"},
+      {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
+      {M + " --radius 1e-3", "--radius: a mesh body's size"},
+      {M + " --mode fresh", "--mode: 'fresh'"},
+      {M + " --backend grid", "--backend: not used by a mesh body"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run(c.args + " --out " + out.string());
+    EXPECT_EQ(r.status, 2) << c.args << "\n" << r.out;
+    EXPECT_NE(r.out.find(c.must_mention), std::string::npos) << c.args << " did not say " << c.must_mention << ":\n" << r.out;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+    fs::remove_all(out);
+  }
+  // What does apply still runs: --spheres and --backend in fixed mode, --speed on a mesh, --mode
+  // fixed on a level-radii scene once --asperity-radius made it the paper's run.
+  for (const std::string& ok : std::vector<std::string>{"--mode fixed --spheres 2 --backend grid --asperities 500 --drops 200",
+                               M + " --speed 1 --omega-x 0.1 --spheres 1",
+                               L + " --asperity-radius 1e-6 --mode fixed --spheres 3 --drops 300"}) {
+    const CliRun r = run(ok + " --no-plots --out " + out.string());
+    EXPECT_TRUE(r.status == 0 || r.status == 1) << ok << "\n" << r.out;
+    fs::remove_all(out);
+  }
+  fs::remove(lv);
+  fs::remove(mesh);
+}
+
+// The progress line: silent for the first second, then on stderr (its own stream here).
+TEST(CliProgress, ShownOnlyWhenTheRunIsLong) {
+  double now = 100.0;
+  for (const bool tty : {false, true}) {
+    std::FILE* f = std::tmpfile();
+    ASSERT_NE(f, nullptr);
+    now = 100.0;
+    asperity::cli::ProgressLine line(true, f, tty, [&] { return now; });
+    now = 100.5;
+    line(10, 100);  // half a second: a short run stays quiet
+    std::fflush(f);
+    EXPECT_EQ(std::ftell(f), 0L) << tty;
+    now = 101.5;
+    line(50, 100);
+    now = 102.0;
+    line(100, 100);
+    line.finish();
+    std::fflush(f);
+    std::rewind(f);
+    char buf[512] = {};
+    const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+    const std::string text(buf, n);
+    EXPECT_NE(text.find("50% (50 / 100), 1.5 s"), std::string::npos) << text;
+    EXPECT_EQ(text.find("10 / 100"), std::string::npos) << text;
+    EXPECT_NE(text.find("100% (100 / 100)"), std::string::npos) << text;
+    std::fclose(f);
+  }
+  // Disabled (--quiet): nothing, however long.
+  std::FILE* f = std::tmpfile();
+  asperity::cli::ProgressLine quiet(false, f, false, [&] { return now; });
+  now += 100;
+  quiet(1, 2);
+  std::fflush(f);
+  EXPECT_EQ(std::ftell(f), 0L);
+  std::fclose(f);
+}
+
+}  // namespace
+
+namespace {
+
+// A decisive law that cannot be evaluated is visible: verdict "skipped" (p, D null) in tests[],
+// a `skipped` count, the table and a warning on stderr. Exit status stays 0: nothing was rejected.
+// Here: at 1e-12 m/s some drops do not impact, so the Sec. IV laws do not apply to the sample.
+TEST(CliReport, ASkippedDecisiveLawIsVisible) {
+  for (const std::string mode : {"", " --mode fixed --spheres 4"}) {
+    const fs::path out = fresh_dir("skipped");
+    const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q --no-plots --speed 1e-12 --drops 100 --seed 2" + mode +
+                            " --out " + out.string();
+    const auto err = asperity::testing::run_command(cmd + " 2>&1 >/dev/null");
+    ASSERT_EQ(err.status, 0) << err.out;
+    EXPECT_NE(err.out.find("warning: 2 decisive tests were skipped"), std::string::npos) << err.out;
+    EXPECT_NE(err.out.find("eq28-corrected"), std::string::npos) << err.out;
+    const auto j = read_report(out / "report.json");
+    EXPECT_EQ(j.at("skipped"), 2) << mode;
+    EXPECT_EQ(j.at("rejected"), false);
+    std::set<std::string> decisive_skipped;
+    for (const auto& t : j.at("tests")) {
+      if (t.at("verdict") != "skipped") continue;
+      EXPECT_TRUE(t.at("p").is_null() && t.at("D").is_null()) << t.dump();
+      EXPECT_NE(t.at("note").get<std::string>().find("did not impact"), std::string::npos) << t.dump();
+      if (t.at("decisive").get<bool>()) decisive_skipped.insert(t.at("law").get<std::string>());
+    }
+    EXPECT_EQ(decisive_skipped, (std::set<std::string>{"eq28-corrected", "eq33-corrected"})) << mode;
+    EXPECT_NE(slurp_file(out / "report.txt").find("2 decisive tests SKIPPED"), std::string::npos);
+    fs::remove_all(out);
+  }
+  // A run without skipped laws says nothing on stderr (with -q) and counts 0.
+  const fs::path out = fresh_dir("not-skipped");
+  const auto err = asperity::testing::run_command(std::string(VALIDATE_GEOMETRY) + " -q --no-plots --preset fig4 "
+                                                  "--asperities 500 --drops 500 --out " + out.string() + " 2>&1 >/dev/null");
+  EXPECT_TRUE(err.status == 0 || err.status == 1);
+  EXPECT_EQ(err.out, "");
+  EXPECT_EQ(read_report(out / "report.json").at("skipped"), 0);
+  fs::remove_all(out);
+}
+
+}  // namespace
+
+namespace {
+
+// A run whose report cannot be written leaves nothing behind: not the PLY and figures it wrote
+// before, not the table (here the report's name is taken by a directory).
+TEST(CliReport, AFailedReportWriteRemovesWhatTheRunWrote) {
+  const fs::path out = fresh_dir("failwrite");
+  const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
+  const fs::path scene = write_scene("failwrite", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
+                                                      "\"\n[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\n"
+                                                      "spheres = 2\ndrops = 100\n[experiment]\nkind = \"impact\"\n"
+                                                      "V = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n[outputs]\nplots = false\n"
+                                                      "export_ply = \"m.ply\"\ndir = \"" + out.string() + "\"\n");
+  fs::create_directories(out / "report.json" / "occupied");
+  const CliRun r = run("--scene " + scene.string());
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("report.json"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(out / "m.ply"));
+  EXPECT_FALSE(fs::exists(out / "report.txt"));
+  std::size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(out)) ++entries;
+  EXPECT_EQ(entries, 1u) << "only the directory that was there before";
+  fs::remove_all(out);
+  fs::remove(scene);
+}
+
+}  // namespace

@@ -16,6 +16,10 @@ struct Curve {
   std::vector<double> x, y;
 };
 
+/// f (e.g. a law's pdf) at segments + 1 equally spaced points on [lo, hi]; where f is not finite
+/// the curve is drawn at 0.
+Curve sampled_curve(const std::function<double(double)>& f, std::string label, double lo, double hi, int segments = 300);
+
 struct HistogramFigure {
   std::string title;        ///< e.g. "r_{xy}, N = 10^5, fresh, 10^6 drops"
   std::string xlabel;       ///< with units, e.g. "r_x [µm]"

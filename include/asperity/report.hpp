@@ -32,7 +32,9 @@ struct TestReport {
   double predicted_mean = 0;  ///< mean of the quantity under the law (NaN if not applicable)
   bool iid = true;            ///< whether the p-value's iid assumption holds for these samples
   bool decisive = true;       ///< counts towards the exit status
-  std::string verdict;        ///< "accept", "reject", "quenched" (fixed: expected deviation), "n/a"
+  /// "accept", "reject", "quenched" (fixed: expected deviation), "skipped" (the law could not be
+  /// evaluated: D, p and predicted_mean NaN, the note says why)
+  std::string verdict;
   std::string note;
 };
 
@@ -60,6 +62,8 @@ struct GeometryReport {
 
   /// A decisive test rejected its law.
   bool rejected() const;
+  /// Decisive tests that could not be evaluated (verdict "skipped").
+  std::size_t skipped() const;
 };
 
 /// Summaries and tests of a run: the contact laws only if scene.contact_stats, the restitution laws
@@ -74,6 +78,26 @@ std::string to_json(const GeometryReport& r);
 
 /// Writes `text` to `file` atomically (temporary + rename): never a partial file.
 void write_file_atomic(const std::filesystem::path& file, const std::string& text);
+
+/// The fields every report.json has, whatever kind of run wrote it (README "report.json").
+struct ReportHeader {
+  std::string tool = "validate-geometry";
+  std::string scene;                    ///< scene name ("+custom" when the command line overrode it)
+  std::string scene_toml;               ///< the effective scene as a scene file (to_toml); empty: omitted
+  std::vector<PlanStage> plan;          ///< empty: omitted
+  std::vector<std::pair<std::string, double>> timings_s;  ///< wall seconds per stage; empty: omitted
+};
+
+/// `body` (a JSON object, as the to_json functions return it) with the header fields set:
+/// schema_version, tool, scene, and scene_file, plan, timings_s when the header has them.
+/// Fields of `body` are kept, except that the header's values win for these names.
+std::string with_header(const std::string& body, const ReportHeader& h);
+
+/// The one writer of a run's report files: `dir / report_name` (the JSON text) and, next to it,
+/// the table as `<stem>.txt`, each atomically. If either cannot be written, neither is left
+/// behind; throws std::runtime_error naming the file. Returns the paths written.
+std::vector<std::filesystem::path> write_report_files(const std::filesystem::path& dir, const std::string& report_name,
+                                                      const std::string& json, const std::string& table);
 
 /// Writes the PNG figures of r_xy, r_x, r_y against their laws into `dir`; returns file names.
 std::vector<std::string> write_plots(const std::filesystem::path& dir, const Scene& scene, const ContactSamples& s);

@@ -92,11 +92,52 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     auto given = [&](const char* name) { return app.count(name) > 0; };
     Scene scene = !given("--scene") ? preset(preset_name) : load ? load(scene_file) : load_scene(scene_file);
     auto& e = scene.ensemble;
+    // Options override the file (README "Scenes"). An option that cannot apply to the scene's
+    // kind of run is an error naming it and why, never silently ignored.
+    auto refuse = [](const std::string& option, const std::string& why) { throw BadInput(option + ": " + why); };
     if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities);
-    if (given("--radius")) e.sphere.radius = parse_positive("--radius", radius);
-    if (given("--asperity-radius")) e.sphere.asperity_radius = parse_positive("--asperity-radius", asperity_radius);
-    if (given("--drops")) e.drops = parse_count("--drops", drops);
-    if (given("--spheres")) e.spheres = parse_count("--spheres", spheres);
+    if (given("--radius")) {
+      const double r = parse_positive("--radius", radius);
+      if (scene.mesh)
+        refuse("--radius", "a mesh body's size is its mesh file x body.scale (body.kind = \"mesh\"); --radius is the "
+                           "radius of a sphere body");
+      e.sphere.radius = r;
+    }
+    if (given("--asperity-radius")) {
+      // Every asperity gets this radius: the option replaces a "levels"/"lognormal" distribution of
+      // the file by "fixed" (on a sphere the run becomes the paper's; a mesh stays a mesh run).
+      e.sphere.asperity_radius = parse_positive("--asperity-radius", asperity_radius);
+      scene.radii.reset();
+    }
+    const bool bounce = scene.bounce.enabled, mesh = scene.mesh.has_value(), radii = scene.radii && !scene.mesh;
+    const std::string kind = bounce ? "a bounce run (experiment.kind = \"bounce\")"
+                             : mesh ? "a mesh body (body.kind = \"mesh\")"
+                                    : "a run with unequal asperity radii on a sphere (asperities.radius \"" +
+                                          std::string(radii && scene.radii->radii.kind == RadiusDistribution::Kind::lognormal
+                                                          ? "lognormal"
+                                                          : "levels") +
+                                          "\")";
+    if (given("--drops")) {
+      e.drops = parse_count("--drops", drops);
+      if (bounce) refuse("--drops", "not used by " + kind + ", which counts bounce sequences: use --sequences");
+    }
+    if (given("--mode")) {
+      e.mode = parse_mode(mode);
+      if (bounce) refuse("--mode", "not used by " + kind + ": every sequence bounces its own sphere");
+      if (mesh && e.mode != Mode::fixed)
+        refuse("--mode", "'" + mode + "': " + kind + " runs explicit bodies x rotations: only \"fixed\"");
+      if (radii && e.mode != Mode::fresh)
+        refuse("--mode", "'" + mode + "': " + kind + " draws fresh spheres and screens [screening] bodies: only "
+                         "\"fresh\" (or give --asperity-radius for the paper's equal radii)");
+    }
+    if (given("--spheres")) {
+      e.spheres = parse_count("--spheres", spheres);
+      if (bounce || radii)
+        refuse("--spheres", "not used by " + kind + (radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
+      if (!mesh && e.mode != Mode::fixed)
+        refuse("--spheres", "only for fixed mode (explicit spheres x rotations); fresh mode draws a new sphere per drop: "
+                            "add --mode fixed");
+    }
     if (given("--seed")) {
       std::size_t used = 0;
       try {
@@ -107,19 +148,30 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
       if (seed.empty() || used != seed.size() || seed.front() == '-')
         throw BadInput("--seed: '" + seed + "' is not a non-negative integer");
     }
-    if (given("--mode")) e.mode = parse_mode(mode);
     if (given("--speed")) {
+      const double u = parse_positive("--speed", speed, "m/s");
+      if (radii) refuse("--speed", kind + " is analysed as contacts only (no impacts)");
       e.impact.enabled = true;
       scene.restitution_stats = true;
-      e.impact.speed = parse_positive("--speed", speed, "m/s");
+      e.impact.speed = u;
     }
     if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", omega_x);
     if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", omega_y);
-    if ((given("--omega-x") || given("--omega-y")) && !e.impact.enabled)
-      throw BadInput("--omega-x/--omega-y need an impact: give --speed or a preset with impacts (fig4, fig5)");
+    if (given("--omega-x") || given("--omega-y")) {
+      const std::string opt = given("--omega-x") ? "--omega-x" : "--omega-y";
+      if (bounce) refuse(opt, "not used by " + kind + ": every sequence starts without spin (Omega = 0, Sec. V)");
+      if (radii) refuse(opt, kind + " is analysed as contacts only (no impacts)");
+      if (!e.impact.enabled)
+        refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
+    }
     if (given("--backend")) {
       e.backend = parse_backend(backend);
       scene.backend_auto = false;
+      if (bounce || mesh || radii)
+        refuse("--backend", "not used by " + kind + (bounce ? "" : ", which queries the exact support tree"));
+      if (e.mode != Mode::fixed)
+        refuse("--backend", "only for fixed mode (explicit spheres); fresh mode queries no index (the lowest asperities "
+                            "are drawn exactly): add --mode fixed");
     }
     if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
       throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
@@ -145,6 +197,9 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     if (given("--alpha")) {
       const double a = parse_real("--alpha", alpha);
       if (!(a > 0 && a < 1)) throw BadInput("--alpha: '" + alpha + "' must be in (0, 1)");
+      if (scene.bounce.enabled)
+        throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
+                       "decide nothing (exit status 0)");
       scene.alpha = a;
     }
     if (no_plots) scene.plots = false;

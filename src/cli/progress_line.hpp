@@ -1,0 +1,59 @@
+#pragma once
+// The progress line of validate-geometry on stderr: silent for runs shorter than a second, one
+// overwritten line on a terminal, a line per 10% otherwise. The clock and the stream are
+// parameters so that tests can drive it (tests/test_cli.cpp).
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+
+namespace asperity::cli {
+
+class ProgressLine {
+ public:
+  using Clock = std::function<double()>;  ///< seconds since an arbitrary origin
+
+  static double steady_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+
+  explicit ProgressLine(bool enabled, std::FILE* out = stderr, bool tty = ::isatty(2) != 0,
+                        Clock clock = &ProgressLine::steady_seconds, double quiet_for_s = 1.0)
+      : on_(enabled), tty_(tty), out_(out), clock_(std::move(clock)), quiet_for_(quiet_for_s), start_(clock_()) {}
+
+  void operator()(std::uint64_t done, std::uint64_t total) {
+    if (!on_ || total == 0) return;
+    const double now = clock_(), elapsed = now - start_;
+    if (elapsed < quiet_for_) return;  // short runs stay quiet
+    const int pct = static_cast<int>(100.0 * double(done) / double(total));
+    if (tty_) {
+      if (shown_ && now - last_ < 0.25 && done < total) return;
+      std::fprintf(out_, "\r  drops: %3d%% (%llu / %llu), %.1f s", pct, (unsigned long long)done,
+                   (unsigned long long)total, elapsed);
+      shown_ = true;
+    } else if (pct >= next_pct_) {
+      std::fprintf(out_, "  drops: %d%% (%llu / %llu), %.1f s\n", pct, (unsigned long long)done,
+                   (unsigned long long)total, elapsed);
+      next_pct_ = pct / 10 * 10 + 10;
+    }
+    last_ = now;
+  }
+  /// Ends the overwritten line (terminal) so that the next output starts on its own line.
+  void finish() {
+    if (shown_) std::fprintf(out_, "\n");
+    shown_ = false;
+  }
+
+ private:
+  bool on_, tty_;
+  std::FILE* out_;
+  Clock clock_;
+  double quiet_for_;
+  double start_, last_ = 0;
+  bool shown_ = false;
+  int next_pct_ = 10;
+};
+
+}  // namespace asperity::cli
