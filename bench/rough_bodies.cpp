@@ -242,13 +242,14 @@ int main(int argc, char** argv) {
       if (!b_smooth.empty()) be.smooth = parse_list(b_smooth, "--smooth");
       const auto w = parse_list(b_omega, "--omega");
       if (w.size() != 3) throw std::invalid_argument("--omega needs wx,wy,wz, got '" + b_omega + "'");
-      be.options.omega = Vec3(w[0], w[1], w[2]);
+      be.options.bounce.omega = Vec3(w[0], w[1], w[2]);
       be.radii = RadiusDistribution::fixed(b_radius);
       be.plots = !b_no_plots;
-      be.progress = [](std::uint64_t done, std::uint64_t n) { std::cerr << "\r  sequences " << done << " / " << n << std::flush; };
-      const MeshBounceReport r = run_mesh_bounces(be);
+      const MeshBounceReport r = run_mesh_bounces(
+          be, [](std::uint64_t done, std::uint64_t n) { std::cerr << "\r  sequences " << done << " / " << n << std::flush; });
       std::cerr << "\n";
       std::cout << format_table(r);
+      write_driver_report(be.out, "bounce", to_json(r), format_table(r));
       return 0;
     }
     if (*sbench) {

@@ -22,7 +22,6 @@
 #include "asperity/body_impact.hpp"
 #include "asperity/mesh.hpp"
 #include "asperity/plot.hpp"
-#include "asperity/report.hpp"
 #include "asperity/random.hpp"
 #include "asperity/restitution.hpp"
 #include "format.hpp"
@@ -100,7 +99,6 @@ void validate(const BodyBounceOptions& o) {
     throw std::invalid_argument("bounce: variants must be \"dynamic\" for a body (orientation carried by the free rotation), got " +
                                 std::to_string(o.bounce.variants.size()) + " variant(s) starting with " +
                                 std::string(to_string(o.bounce.variants.front())));
-  if (!o.omega.allFinite()) throw std::invalid_argument("bounce: Omega must be finite");
   if (!std::isfinite(o.max_time) || !(o.max_time > 0)) throw std::invalid_argument("bounce: max_time must be finite and > 0 s, got " + num(o.max_time));
   if (!std::isfinite(o.landing.time_tolerance) || !(o.landing.time_tolerance > 0))
     throw std::invalid_argument("bounce: time_tolerance must be finite and > 0 s, got " + num(o.landing.time_tolerance));
@@ -133,7 +131,7 @@ void run_sequence(std::uint64_t s, const RoughBody& b, const BodyBounds& bb, con
   const double g = o.bounce.gravity;
   Stream st(seed, Purpose::bounce, s, kBodyBounceSub);
   Rotation q = random_rotation(st);
-  Vec3 V(0, 0, -o.bounce.speed), W = o.omega;
+  Vec3 V(0, 0, -o.bounce.speed), W = o.bounce.omega;
   double z = index.support(body_down(q)).h;  // touching at t = 0
   out.e0 = body_energy(b, q, V, W, z, g);
   double T_prev = kNaN, time = 0;
@@ -182,7 +180,7 @@ void run_sequence(std::uint64_t s, const RoughBody& b, const BodyBounds& bb, con
 }  // namespace
 
 BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const BodyBounceOptions& o, std::uint64_t seed,
-                                   int threads, const std::function<void(std::uint64_t, std::uint64_t)>& progress) {
+                                   int threads, const Progress& progress) {
   validate(o);
   if (bodies.empty()) throw std::invalid_argument("bounce: no bodies");
   for (const auto& b : bodies)
@@ -383,11 +381,10 @@ void plot_eps_vs_speed(const std::filesystem::path& png, const BodyBounceReport&
 
 }  // namespace
 
-MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e) {
+MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e, const Progress& progress) {
   validate(e);
   MeshBounceReport r;
   r.experiment = e;
-  r.experiment.progress = {};
   const auto t0 = std::chrono::steady_clock::now();
   auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   std::vector<RoughBody> bodies(static_cast<std::size_t>(e.bodies));
@@ -410,10 +407,12 @@ MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e) {
   r.principal_moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(bodies[0].inertia, Eigen::EigenvaluesOnly).eigenvalues();
   for (const auto& b : bodies) r.c_max = std::max(r.c_max, BodyBounds::of(b).c_max);
   r.seconds_build = since(t0);
-  const BodyBounceSamples S = run_body_bounces(bodies, e.options, e.seed, e.threads, e.progress);
+  const BodyBounceSamples S = run_body_bounces(bodies, e.options, e.seed, e.threads, progress);
   r.seconds_run = S.seconds, r.seconds_index = S.seconds_index;
   const auto t2 = std::chrono::steady_clock::now();
   r.report = analyse_body_bounces(S, e.options.bounce, e.seed);
+  r.seconds_analysis = since(t2);
+  const auto t3 = std::chrono::steady_clock::now();
   std::filesystem::create_directories(e.out);
   if (e.plots && plotting_available()) {
     std::ostringstream sub;
@@ -441,9 +440,7 @@ MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e) {
     }
     for (const auto& f : write_bounce_plots(e.out, {r.report.base})) r.plots.push_back(f);
   }
-  r.seconds_analysis = since(t2);
-  write_file_atomic(e.out / "report.json", to_json(r));
-  write_file_atomic(e.out / "report.txt", format_table(r));
+  r.seconds_plots = since(t3);
   return r;
 }
 
@@ -459,7 +456,7 @@ std::string format_table(const MeshBounceReport& r) {
      << e.asperities << ", radii " << e.radii.describe() << ", " << e.bodies << " bodies\n";
   os << "mass " << r.mass << " kg, principal moments " << r.principal_moments.transpose() << " kg m^2, max |c_i| " << r.c_max
      << " m\n";
-  os << "first impact u = " << e.options.bounce.speed << " m/s, Omega = " << e.options.omega.transpose() << " rad/s, stop below "
+  os << "first impact u = " << e.options.bounce.speed << " m/s, Omega = " << e.options.bounce.omega.transpose() << " rad/s, stop below "
      << e.options.bounce.stop_speed << " m/s, g = " << e.options.bounce.gravity << " m/s^2\n";
   os << b.base.sequences << " sequences, " << b.base.impacts << " impacts: " << b.base.impacts_per_sequence << " +- "
      << b.impacts_per_sequence_sd << " (sd) per sequence, max " << b.impacts_max << "\n";
@@ -474,7 +471,8 @@ std::string format_table(const MeshBounceReport& r) {
      << "\n";
   os << "landing search: " << b.queries_per_flight << " support queries per flight, flights < 1 ms: " << b.short_flights << "\n";
   os << "run " << r.seconds_run << " s (" << static_cast<double>(b.base.sequences) / r.seconds_run << " sequences/s), bodies "
-     << r.seconds_build << " s, support trees " << r.seconds_index << " s, analysis " << r.seconds_analysis << " s\n\n";
+     << r.seconds_build << " s, support trees " << r.seconds_index << " s, analysis " << r.seconds_analysis << " s, figures "
+     << r.seconds_plots << " s\n\n";
   os << "u bin [m/s]        n   <eps> +- se          eps 10% .. 90%     <|Omega|> [rad/s]\n";
   for (const auto& x : b.by_speed) {
     char line[160];
@@ -494,9 +492,8 @@ std::string to_json(const MeshBounceReport& r) {
   // The fig6 report of the same groups and fits (bounce.hpp), with the body in place of the sphere.
   SphereParams none;
   none.asperities = e.asperities;
-  nlohmann::json j = nlohmann::json::parse(bounce_to_json(e.scene, none, e.options.bounce, e.seed, {b.base}, r.plots));
-  j["schema_version"] = kReportSchemaVersion;
-  j["scene_file"] = e.scene_file;
+  nlohmann::json j = nlohmann::json::parse(bounce_to_json("", none, e.options.bounce, e.seed, {b.base}, r.plots));
+  j.erase("scene");  // the header's (with_header, report.hpp)
   j["mode"] = "body-bounce";
   j["parameters"] = {{"asperities", e.asperities}, {"radii", e.radii.describe()}, {"bodies", e.bodies}, {"seed", e.seed}};
   j["body"] = {{"name", r.body_name},
@@ -513,7 +510,8 @@ std::string to_json(const MeshBounceReport& r) {
     bins.push_back({{"range", {x.lo, x.hi}}, {"n", x.n}, {"eps_mean", jnum(x.eps.value)}, {"eps_mean_se", jnum(x.eps.se)},
                     {"eps_q10", jnum(x.eps_q10)}, {"eps_q90", jnum(x.eps_q90)}, {"spin_mean_rad_s", jnum(x.spin_mean)}});
   const auto& st = b.stops;
-  j["bounce"]["omega_rad_s"] = {e.options.omega.x(), e.options.omega.y(), e.options.omega.z()};
+  const Vec3& w0 = e.options.bounce.omega;
+  j["bounce"]["omega_rad_s"] = {w0.x(), w0.y(), w0.z()};
   j["bounce"]["max_time_s"] = e.options.max_time;
   j["bounce"]["max_impacts"] = e.options.bounce.max_impacts;
   j["bounce"]["time_tolerance_s"] = e.options.landing.time_tolerance;
@@ -539,7 +537,8 @@ std::string to_json(const MeshBounceReport& r) {
                          {"seconds_index", r.seconds_index},
                          {"seconds_run", r.seconds_run},
                          {"sequences_per_second", jnum(static_cast<double>(b.base.sequences) / r.seconds_run)},
-                         {"seconds_analysis", r.seconds_analysis}};
+                         {"seconds_analysis", r.seconds_analysis},
+                         {"seconds_plots", r.seconds_plots}};
   return j.dump(2) + "\n";
 }
 

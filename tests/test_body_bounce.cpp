@@ -210,7 +210,7 @@ TEST(BodyBounce, RoughSphereFirstImpactFollowsEq28) {
   o.bounce.sequences = 16000;
   o.bounce.speed = 1.3;
   o.bounce.max_impacts = 1;
-  o.omega = Vec3(0.2, 0, 0);
+  o.bounce.omega = Vec3(0.2, 0, 0);
   const BodyBounceSamples s = run_body_bounces(bodies, o, 21, 2);
   ASSERT_EQ(s.base.eps.size(), 16000u);
   auto eps = s.base.eps;
@@ -246,7 +246,7 @@ TEST(BodyBounce, OneAndTwoThreadsAreBitIdentical) {
   o.bounce.speed = 0.5;
   o.bounce.stop_speed = 0.2;
   o.bounce.max_impacts = 20;
-  o.omega = Vec3(1, 2, 0);
+  o.bounce.omega = Vec3(1, 2, 0);
   const auto a = run_body_bounces(bodies, o, 3, 1), c = run_body_bounces(bodies, o, 3, 2);
   EXPECT_EQ(a.base.sequence, c.base.sequence);
   EXPECT_EQ(a.base.eps, c.base.eps);
@@ -268,9 +268,9 @@ TEST(BodyBounce, RefusesBadOptions) {
   o.max_time = 0;
   EXPECT_THROW(validate(o), std::invalid_argument);
   o.max_time = 1;
-  o.omega = Vec3(std::nan(""), 0, 0);
+  o.bounce.omega = Vec3(std::nan(""), 0, 0);
   EXPECT_THROW(validate(o), std::invalid_argument);
-  o.omega = Vec3::Zero();
+  o.bounce.omega = Vec3::Zero();
   EXPECT_THROW(run_body_bounces(std::vector<RoughBody>{}, o, 1), std::invalid_argument);
 }
 

@@ -46,6 +46,7 @@
 
 #include "asperity/body.hpp"
 #include "asperity/bounce.hpp"
+#include "asperity/ensemble.hpp"
 #include "asperity/free_rotation.hpp"
 #include "asperity/orientation.hpp"
 #include "asperity/support.hpp"
@@ -97,10 +98,11 @@ Landing next_landing(const RoughBody& b, const BodyBounds& bb, const SupportQuer
 double body_energy(const RoughBody& b, const Rotation& q, const Vec3& V, const Vec3& Omega, double z, double g);
 
 struct BodyBounceOptions {
-  /// sequences, speed, stop_speed, gravity, beta, eps_t, max_impacts, windows, impact_numbers,
-  /// bootstrap. density is unused (the bodies carry their mass); variants must be {dynamic}.
+  /// sequences, speed, omega (spin at the first impact), stop_speed, gravity, beta, eps_t,
+  /// max_impacts, windows, impact_numbers, bootstrap. density is unused (the bodies carry their
+  /// mass); variants must be {dynamic} (the orientation carried by the free rotation: the only
+  /// meaning bounce variants have for a body).
   BounceExperiment bounce;
-  Vec3 omega{0, 0, 0};     ///< spin at the first impact, world frame [rad/s]
   double max_time = 60;    ///< total time per sequence [s]
   LandingOptions landing;
 };
@@ -137,7 +139,7 @@ struct BodyBounceSamples {
 /// `progress` (optional) is called between chunks with (sequences done, total).
 BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const BodyBounceOptions& o, std::uint64_t seed,
                                    int threads = 0,
-                                   const std::function<void(std::uint64_t, std::uint64_t)>& progress = {});
+                                   const Progress& progress = {});
 
 /// eps and spin in one impact-speed bin.
 struct SpeedBin {
@@ -175,10 +177,9 @@ namespace asperity {
 /// A bounce run as the CLI makes it: K rough bodies from a mesh (mesh.hpp, like run_mesh_impacts)
 /// or, with `mesh` empty, rough spheres of radius `sphere_radius` (make_rough_sphere_body: the
 /// same engine on the paper's body, for comparison), then run_body_bounces and the analysis.
-/// Writes report.json, report.txt and PNG figures into `out` when asked.
+/// Writes PNG figures into `out` when asked; the report (to_json, format_table) goes through the
+/// one writer of report.hpp (with_header, write_report_files), as for every run.
 struct MeshBounceExperiment {
-  std::string scene = "custom";          ///< scene name for the report
-  std::string scene_file;                ///< scene file path ("" for presets / API use)
   std::filesystem::path mesh = "meshes/ellipsoid.off";
   double scale = 1.0;                    ///< mesh coordinates -> metres
   std::vector<double> smooth;            ///< {a, b, c[, m]} [m]: centres mapped onto that (super)ellipsoid
@@ -191,7 +192,6 @@ struct MeshBounceExperiment {
   int threads = 0;
   BodyBounceOptions options;             ///< options.bounce.density is ignored (density above)
   bool plots = true;
-  std::function<void(std::uint64_t, std::uint64_t)> progress;  ///< (sequences done, total), optional
   std::filesystem::path out = "asperity-bounce";
 };
 void validate(const MeshBounceExperiment& e);
@@ -204,10 +204,12 @@ struct MeshBounceReport {
   double c_max = 0;                      ///< max |c_i| over the bodies [m]
   BodyBounceReport report;
   std::vector<std::string> plots;
-  double seconds_build = 0, seconds_index = 0, seconds_run = 0, seconds_analysis = 0;  ///< bodies, trees, sequences, analysis
+  /// bodies, support trees, sequences, analysis, figures (wall)
+  double seconds_build = 0, seconds_index = 0, seconds_run = 0, seconds_analysis = 0, seconds_plots = 0;
 };
 
-MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e);
+/// progress: (sequences done, total), between chunks of sequences.
+MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e, const Progress& progress = {});
 std::string format_table(const MeshBounceReport& r);
 std::string to_json(const MeshBounceReport& r);
 
