@@ -138,6 +138,9 @@ void run_sequence(std::uint64_t s, const RoughBody& b, const BodyBounds& bb, con
   for (std::uint32_t k = 1;; ++k) {
     const double u = -V.z();
     if (time > o.max_time) { out.stop = Stop::max_time; return; }
+    // eps = -V'_z/V_z (Eq. 1) is undefined at V_z = 0 exactly (solve_impact refuses it): counted as
+    // no approach rather than thrown inside the parallel loop. Never seen; V_z = v0 - g t.
+    if (V.z() == 0) { out.stop = Stop::no_approach; return; }
     const BodyImpact bi = body_impact(b, index, q, V, W, eps_n, o.bounce.eps_t);
     if (!bi.result) { out.stop = Stop::no_approach; return; }
     const ImpactResult& res = *bi.result;
