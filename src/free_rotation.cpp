@@ -1,14 +1,18 @@
 #include "asperity/free_rotation.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <boost/math/quadrature/gauss_kronrod.hpp>
+#include <boost/math/special_functions/ellint_1.hpp>
+#include <boost/math/special_functions/jacobi_elliptic.hpp>
 
 #include <algorithm>
+#include <limits>
+#include <numbers>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "format.hpp"
-#include "free_rotation_reference.hpp"
 
 namespace asperity {
 
@@ -47,28 +51,169 @@ void validate(const Eigen::Matrix3d& J, const Rotation& q0, const Vec3& w0) {
 
 }  // namespace
 
+
+// The closed form (Landau & Lifshitz Sec. 37). Principal moments ascending J1 <= J2 <= J3 and
+// D = L^2 / 2T. For D > J2 the body circulates about axis 3, for D < J2 about axis 1; the second
+// case is the first in the working frame (e3, -e2, e1) with moments (J3, J2, J1), so one set of
+// formulas with SIGNED differences d_ij = J_i - J_j serves both (sigma = sign d32). In the working
+// frame w = (s1 A1 cn u, A2 sn u, s3 A3 dn u), u = u0 + wp t, s3 = sign w3(0), s1 = sigma s3.
+//
+// Orientation: l(t) = J w / |L| (working frame) must map onto the fixed world direction of L. With
+// n = s3 e3 (n.l > 0 always: w3 never changes sign), M(t) = the minimal rotation taking l to n, and
+// R(t) = G0 Rot_n(psi) M(t) (working frame -> world), R^T R' = [w] gives w = psi' l + mu (mu the
+// body angular velocity of M), so psi' = w.l - mu.l = 2T/|L| - n.(l x l')/(1 + n.l) (the twist of
+// the minimal rotation; its sign is checked by the Odeint comparison, and flipping it fails there).
+// With the elliptic form l1 l2' - l2 l1' = (J1 J2 s1 A1 A2 / L^2) wp dn u, hence
+//   psi(t) = (2T/|L|) t - sigma J1 J2 A1 A2 / L^2 [G(u) - G(u0)],  G(u) = int_0^u dn/(1 + c dn),
+// c = J3 A3 / |L| = n.l at dn = 1. The integrand has period 2K and is even, so G(u) = 2 m G(K) + G(r)
+// with |r| <= K: one quadrature over [0, K] in the constructor, one over [0, |r|] per call.
+// (The third-kind elliptic integral form of G cancels catastrophically as c -> 1, i.e. near pure
+// rotation about axis 3: its two terms grow like 1 / (1 - c^2).)
+//
+// No threshold separates the cases: c = L^2 - 2 T J2 (without cancellation of the large terms)
+// decides the regime; exactly 0 with w1 = w3 = 0 or J2 = J3 ... is a steady rotation about a principal
+// axis (incl. rest and the spherical top), else the separatrix (k = 1: sn = tanh, cn = dn = sech).
+// Symmetric tops are k = 0 (regular precession) and near-degenerate moments are just small k or wp.
 struct FreeRotation::Impl {
-  Eigen::Matrix3d J;
+  enum class Kind { steady, periodic, separatrix } kind = Kind::steady;
   Rotation q0;
   Vec3 omega0;
   Vec3 L;
-  double T;
+  double T = 0;
+  // elliptic parameters (working frame)
+  Rotation Pw = Rotation::Identity();  // working frame -> body
+  Rotation G0 = Rotation::Identity();  // R(0) M(0)^T
+  double J[3] = {0, 0, 0};
+  double A[3] = {0, 0, 0};  // signed: (s1 A1, A2, s3 A3)
+  double Lnorm = 0, rate0 = 0, coef = 0, c = 0;
+  double wp = 0, k = 0, K = 0, GK = 0, u0 = 0, Gu0 = 0;
+  Vec3 n{0, 0, 1};
+
+  static constexpr double kSeparatrixU = 40;  // sech(40) = 8.5e-18: the rest of G is below rounding
+
+  double g(double u) const {
+    double cn, dn;
+    boost::math::jacobi_elliptic(k, u, &cn, &dn);
+    return dn / (1 + c * dn);
+  }
+  double quad(double x) const {  // int_0^x g, x >= 0
+    if (x == 0) return 0;
+    return boost::math::quadrature::gauss_kronrod<double, 31>::integrate([this](double u) { return g(u); }, 0.0, x,
+                                                                         10, 1e-14);
+  }
+  double G(double u) const {
+    if (kind == Kind::separatrix) return std::copysign(quad(std::min(std::abs(u), kSeparatrixU)), u);
+    const double m = std::floor((u + K) / (2 * K));
+    const double r = u - 2 * K * m;
+    return 2 * m * GK + std::copysign(quad(std::abs(r)), r);
+  }
+  Vec3 w_work(double u) const {
+    double cn, dn;
+    const double sn = boost::math::jacobi_elliptic(k, u, &cn, &dn);
+    return {A[0] * cn, A[1] * sn, A[2] * dn};
+  }
+  Rotation M(const Vec3& w) const {  // minimal rotation l -> n
+    const Vec3 l = Vec3(J[0] * w.x(), J[1] * w.y(), J[2] * w.z()) / Lnorm;
+    const Vec3 ax = l.cross(n);
+    return Rotation(1 + l.dot(n), ax.x(), ax.y(), ax.z()).normalized();
+  }
 };
 
 FreeRotation::FreeRotation(const Eigen::Matrix3d& inertia_body, const Rotation& q0, const Vec3& omega0) {
   validate(inertia_body, q0, omega0);
   auto p = std::make_shared<Impl>();
-  p->J = 0.5 * (inertia_body + inertia_body.transpose());
+  const Eigen::Matrix3d Jb = 0.5 * (inertia_body + inertia_body.transpose());
   p->q0 = q0.normalized();
   p->omega0 = omega0;
-  const Eigen::Matrix3d R = p->q0.toRotationMatrix();
-  p->L = R * (p->J * (R.transpose() * omega0));
+  const Eigen::Matrix3d Rq = p->q0.toRotationMatrix();
+  p->L = Rq * (Jb * (Rq.transpose() * omega0));
   p->T = 0.5 * omega0.dot(p->L);
+
+  // Principal frame: deterministic signs (largest component of each axis positive), right-handed.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(Jb);
+  Eigen::Matrix3d P = es.eigenvectors();
+  for (int j = 0; j < 3; ++j) {
+    Eigen::Index i;
+    P.col(j).cwiseAbs().maxCoeff(&i);
+    if (P(i, j) < 0) P.col(j) = -P.col(j);
+  }
+  if (P.determinant() < 0) P.col(1) = -P.col(1);
+  const Eigen::Vector3d Jp = es.eigenvalues();
+  const Vec3 w = P.transpose() * (Rq.transpose() * omega0);
+  const double d21 = Jp(1) - Jp(0), d32 = Jp(2) - Jp(1);
+  const double c = Jp(2) * d32 * w.z() * w.z() - Jp(0) * d21 * w.x() * w.x();  // L^2 - 2 T J2
+  if (c == 0 && (w.z() == 0 || d32 == 0)) {
+    p->kind = Impl::Kind::steady;  // J w parallel to w: rest, spherical top, principal axis
+    impl_ = std::move(p);
+    return;
+  }
+  Eigen::Matrix3d Pw = P;
+  Vec3 ww = w;
+  double Jw[3] = {Jp(0), Jp(1), Jp(2)};
+  if (c < 0) {  // about axis 1: working frame (e3, -e2, e1)
+    Pw.col(0) = P.col(2), Pw.col(1) = -P.col(1), Pw.col(2) = P.col(0);
+    ww = Vec3(w.z(), -w.y(), w.x());
+    std::swap(Jw[0], Jw[2]);
+  }
+  p->Pw = Rotation(Pw).normalized();
+  for (int i = 0; i < 3; ++i) p->J[i] = Jw[i];
+  const double J1 = Jw[0], J2 = Jw[1], J3 = Jw[2];
+  const double e21 = J2 - J1, e31 = J3 - J1, e32 = J3 - J2;  // signed; e32 and e31 have sign sigma
+  const double sigma = e32 > 0 ? 1.0 : -1.0;
+  const double w1 = ww.x(), w2 = ww.y(), w3 = ww.z();
+  const double A1 = std::sqrt(w1 * w1 + (J2 * e32) / (J1 * e31) * w2 * w2);
+  const double A2 = std::sqrt(w2 * w2 + (J1 * e31) / (J2 * e32) * w1 * w1);
+  const double A3 = std::sqrt(w3 * w3 + (J2 * e21) / (J3 * e31) * w2 * w2);
+  const double a = J1 * e31 * w1 * w1 + J2 * e32 * w2 * w2;  // 2 T J3 - L^2 (signed like sigma)
+  const double b = J2 * e21 * w2 * w2 + J3 * e31 * w3 * w3;  // L^2 - 2 T J1 (signed like sigma)
+  const double s3 = w3 > 0 ? 1.0 : -1.0, s1 = sigma * s3;
+  p->A[0] = s1 * A1, p->A[1] = A2, p->A[2] = s3 * A3;
+  p->n = Vec3(0, 0, s3);
+  p->Lnorm = p->L.norm();
+  p->rate0 = 2 * p->T / p->Lnorm;
+  p->coef = -sigma * J1 * J2 * A1 * A2 / (p->Lnorm * p->Lnorm);
+  p->c = J3 * A3 / p->Lnorm;
+  p->wp = std::sqrt(e32 * b / (J1 * J2 * J3));
+  const double k2 = e21 * a / (e32 * b);
+  p->k = std::sqrt(std::min(1.0, std::max(0.0, k2)));
+  if (c == 0 || p->k >= 1) {
+    p->k = 1;
+    p->kind = Impl::Kind::separatrix;
+    // sinh u0 = tanh u0 / sech u0 = (w2 / A2) / (|w3| / A3)
+    p->u0 = std::asinh((w2 / A2) * (A3 / std::abs(w3)));
+  } else {
+    p->kind = Impl::Kind::periodic;
+    p->K = boost::math::ellint_1(p->k);
+    const double phi0 = (A1 == 0 && A2 == 0) ? 0.0 : std::atan2(w2 / A2, w1 / p->A[0]);
+    p->u0 = boost::math::ellint_1(p->k, phi0);
+    p->GK = p->quad(p->K);
+  }
+  p->Gu0 = p->G(p->u0);
+  p->G0 = p->q0 * p->Pw * p->M(p->w_work(p->u0)).conjugate();
   impl_ = std::move(p);
 }
 
 RotationState FreeRotation::at(double t) const {
-  return detail::reference_free_rotation(impl_->J, impl_->q0, impl_->omega0, t);
+  const Impl& p = *impl_;
+  if (p.kind == Impl::Kind::steady) {
+    const double wn = p.omega0.norm();
+    if (wn == 0 || t == 0) return {p.q0, p.omega0};
+    return {(Rotation(Eigen::AngleAxisd(wn * t, p.omega0 / wn)) * p.q0).normalized(), p.omega0};
+  }
+  const double u = p.u0 + p.wp * t;
+  const Vec3 w = p.w_work(u);
+  const double psi = p.rate0 * t + p.coef * (p.G(u) - p.Gu0);
+  const Rotation R = p.G0 * Rotation(Eigen::AngleAxisd(psi, p.n)) * p.M(w);
+  RotationState s;
+  s.q = (R * p.Pw.conjugate()).normalized();
+  s.omega = R * w;
+  return s;
+}
+
+double FreeRotation::period() const {
+  const Impl& p = *impl_;
+  if (p.kind != Impl::Kind::periodic) return std::numeric_limits<double>::infinity();
+  return 4 * p.K / p.wp;
 }
 
 Vec3 FreeRotation::angular_momentum() const { return impl_->L; }

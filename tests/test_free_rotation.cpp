@@ -6,6 +6,9 @@
 
 #include "asperity/bounce.hpp"
 #include "asperity/free_rotation.hpp"
+#include "asperity/orientation.hpp"
+#include "asperity/random.hpp"
+#include "free_rotation_reference.hpp"
 
 using namespace asperity;
 
@@ -15,7 +18,50 @@ Eigen::Matrix3d body_inertia(double J1, double J2, double J3, const Rotation& fr
   const Eigen::Matrix3d R = frame.toRotationMatrix();
   return R * Eigen::Vector3d(J1, J2, J3).asDiagonal() * R.transpose();
 }
+struct Body {
+  Eigen::Matrix3d J;
+  Rotation q0;
+  Vec3 w0;
+};
+// Principal moments from random second moments x, y, z >= 0 of a mass distribution (J1 = y + z, ...),
+// so the triangle inequality holds by construction; random principal frame, orientation and spin
+// direction; |Omega| log-uniform in [1e-3, 1e3] rad/s.
+Body random_body(std::uint64_t i) {
+  Stream s(7, Purpose::test, i);
+  const double x = s.uniform(), y = s.uniform(), z = s.uniform(), m = std::exp(std::log(10.0) * (4 * s.uniform() - 2));
+  Body b;
+  b.J = body_inertia(m * (y + z), m * (x + z), m * (x + y), random_rotation(s));
+  b.q0 = random_rotation(s);
+  b.w0 = std::exp(std::log(10.0) * (6 * s.uniform() - 3)) * uniform_on_sphere(s.uniform(), s.uniform());
+  return b;
+}
+// Largest orientation distance and relative angular-velocity difference over the times.
+template <class F>
+double max_error(const Body& b, F&& state_at, const std::vector<double>& times) {
+  double e = 0;
+  for (double t : times) {
+    const RotationState r = detail::reference_free_rotation(b.J, b.q0, b.w0, t);
+    const RotationState s = state_at(t);
+    e = std::max({e, qdist(r.q, s.q), (r.omega - s.omega).norm() / b.w0.norm()});
+  }
+  return e;
+}
 }  // namespace
+
+TEST(FreeRotation, MatchesOdeintReference) {
+  double worst = 0;
+  for (std::uint64_t i = 0; i < 200; ++i) {
+    const Body b = random_body(i);
+    const FreeRotation f(b.J, b.q0, b.w0);
+    const double P = std::isfinite(f.period()) ? f.period() : 1 / b.w0.norm();
+    std::vector<double> times;
+    for (double x : {0.0, 0.1, 0.37, 1.0, 2.5, -1.3, 7.9, 20.0}) times.push_back(x * P);
+    const double e = max_error(b, [&](double t) { return f.at(t); }, times);
+    worst = std::max(worst, e);
+    EXPECT_LT(e, 1e-9) << i;
+  }
+  std::printf("worst %g\n", worst);
+}
 
 TEST(FreeRotation, ConservesMomentumAndEnergy) {
   const Eigen::Matrix3d J = body_inertia(1.0, 2.0, 2.7, Rotation(0.9, 0.1, -0.3, 0.2).normalized());

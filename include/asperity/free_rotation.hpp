@@ -42,6 +42,11 @@ class FreeRotation {
   /// and of the quadrature (relative ~1e-13 per rotation period).
   RotationState at(double t) const;
 
+  /// Period of the body-frame angular velocity [s]: 4 K(k) / omega_p (2 pi / omega_p for a
+  /// symmetric top); infinity for a steady rotation (rest, spherical top, principal axis) and on
+  /// the separatrix. The orientation is not periodic in general (the angle about L is not).
+  double period() const;
+
   Vec3 angular_momentum() const;  ///< L, world frame [kg m^2/s]: constant
   double kinetic_energy() const;  ///< T = Omega . L / 2 [J]: constant
 
