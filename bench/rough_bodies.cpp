@@ -6,6 +6,8 @@
 //   rough_bodies mesh   --mesh meshes/ellipsoid.off [--smooth 4e-3,3e-3,2.25e-3[,m]] [--n 100000]
 //                       [--radius 6.5e-7 | --levels ...] [--bodies 10] [--drops 100000] [--speed 1.3]
 //                       [--omega-x 0.2] [--seed 1] [--out DIR] [--no-plots]
+//   rough_bodies screen --mesh meshes/ellipsoid.off --smooth 4e-3,3e-3,2.25e-3 [--n 100000]
+//                       [--levels 1.3e-6:0.2,6.5e-7:0.8] [--repeats 3] [--directions 400000] [--calibrate]
 //   rough_bodies export --mesh meshes/rounded_cube.off --out body.ply [--n 300] [--radius 5e-5]
 //                       [--style points|spheres] [--inflate 1] [--smooth a,b,c] [--seed 1]
 #include <CLI/CLI.hpp>
@@ -19,11 +21,15 @@
 #include "asperity/mesh.hpp"
 #include "asperity/report.hpp"
 #include "asperity/random.hpp"
+#include "asperity/screening.hpp"
 #include "asperity/support.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <memory>
+#include <numbers>
 
 using namespace asperity;
 
@@ -119,6 +125,112 @@ void write_driver_report(const std::filesystem::path& dir, const std::string& wh
   std::cout << "wrote " << (dir / "report.json").string() << ", report.txt\n";
 }
 
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// Gaussian curvature of |x/a|^m + |y/b|^m + |z/c|^m = 1 at p (mesh coordinates):
+// K = g^T adj(H) g / |g|^4 for the implicit F, H diagonal.
+double superellipsoid_curvature(const Vec3& p, const std::vector<double>& ax) {
+  const double m = ax.size() == 4 ? ax[3] : 2.0;
+  double g[3], h[3];
+  for (int i = 0; i < 3; ++i) {
+    const double a = ax[static_cast<std::size_t>(i)], x = std::abs(p[i]) / a;
+    g[i] = m * std::pow(x, m - 1) / a * (p[i] < 0 ? -1 : 1);
+    h[i] = m * (m - 1) * std::pow(x, m - 2) / (a * a);
+  }
+  const double gg = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+  return (g[0] * g[0] * h[1] * h[2] + g[1] * g[1] * h[0] * h[2] + g[2] * g[2] * h[0] * h[1]) / (gg * gg);
+}
+
+// Screening of one smooth mesh body: kept per level, lambda_eff, counts, timing (median of
+// `repeats`), cross-check, and the kept fraction of the smallest level against the local
+// screening variable x = lambda_top * (rho_top - rho_small) / sqrt(K). On a sphere x = lambda_top
+// drho R; the kept fraction of a paraboloid patch depends on x alone (scale the tangent
+// coordinates by sqrt(kappa_1), sqrt(kappa_2)), so spheres of the same lambda and several R
+// predict it (--calibrate).
+void screen_run(const std::filesystem::path& file, const std::vector<double>& ax, std::uint64_t n, const RadiusDistribution& rd,
+                int repeats, std::uint64_t directions, bool calibrate, std::uint64_t seed) {
+  const TriangleMesh m = read_mesh(file);
+  const Vec3 g = mass_properties(m, 1000).centroid;
+  const RoughBody b = make_rough_mesh_body(m, n, rd, 1000, seed, 0, superellipsoid_surface(ax[0], ax[1], ax[2], ax.size() == 4 ? ax[3] : 2.0),
+                                           file.stem().string());
+  const auto q = make_support_tree(b.centres, b.radii);
+  std::vector<double> secs;
+  ScreeningResult r;
+  for (int k = 0; k < repeats; ++k) {
+    r = screen_body(b, *q);
+    secs.push_back(r.seconds);
+  }
+  const ScreeningCheck c = check_screening(b, *q, r, directions, seed);
+  const auto& lv = rd.levels;
+  std::vector<double> kept(lv.size(), 0), tot(lv.size(), 0), unproven(lv.size(), 0);
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const auto l = static_cast<std::size_t>(std::find(lv.begin(), lv.end(), b.radii[i]) - lv.begin());
+    if (l < lv.size()) tot[l] += 1, kept[l] += r.status[i] != Screen::screened, unproven[l] += r.status[i] == Screen::helly;
+  }
+  std::cout << file.string() << ": N = " << n << ", area " << r.area << " m^2, lambda " << r.lambda << ", lambda_eff " << r.lambda_eff
+            << " (" << r.lambda_eff / r.lambda << " lambda)\n  kept by level:";
+  for (std::size_t l = 0; l < lv.size(); ++l)
+    std::cout << " " << lv[l] << ": " << kept[l] / tot[l] << " (" << unproven[l] << " without proof)";
+  std::cout << "\n  witnessed " << r.witnessed << ", kept without proof " << r.helly << ", screened " << r.screened
+            << ", mean competitors " << r.mean_competitors << "\n  seconds (median of " << repeats << "): " << median(secs)
+            << "\n  cross-check: " << c.directions << " directions, winners screened " << c.winners_screened << ", distinct winners "
+            << c.distinct_winners << ", kept never hit " << c.kept_never_hit << "\n";
+  if (lv.size() != 2) return;
+  const std::size_t top = lv[0] > lv[1] ? 0 : 1, small = 1 - top;
+  const double drho = lv[top] - lv[small], lam_top = rd.fractions[top] * r.lambda;
+  // Sphere calibration f(x): same lambda, R varied.
+  std::vector<std::pair<double, double>> cal;
+  if (calibrate) {
+    for (double R : {1.0e-3, 1.5e-3, 2.0e-3, 3.0e-3, 4.5e-3, 6.0e-3, 9.0e-3}) {
+      SphereParams p;
+      p.radius = R;
+      p.asperities = static_cast<std::uint64_t>(std::llround(r.lambda * 4 * std::numbers::pi * R * R));
+      const RoughBody s = make_rough_sphere_body(p, rd, seed, 0);
+      const auto qs = make_support_tree(s.centres, s.radii);
+      const ScreeningResult rs = screen_sphere(s, *qs);
+      double k = 0, t = 0;
+      for (std::size_t i = 0; i < s.size(); ++i)
+        if (s.radii[i] == lv[small]) t += 1, k += rs.status[i] != Screen::screened;
+      cal.emplace_back(lam_top * drho * R, k / t);
+      std::cout << "  sphere R = " << R << " m, N = " << p.asperities << ": x = " << cal.back().first << ", small kept " << cal.back().second
+                << ", screen_sphere " << rs.seconds << " s\n";
+    }
+  }
+  auto f = [&](double x) {
+    if (cal.empty()) return std::numeric_limits<double>::quiet_NaN();
+    if (x <= cal.front().first) return cal.front().second;
+    for (std::size_t i = 1; i < cal.size(); ++i)
+      if (x <= cal[i].first) {
+        const double t = std::log(x / cal[i - 1].first) / std::log(cal[i].first / cal[i - 1].first);
+        return cal[i - 1].second + t * (cal[i].second - cal[i - 1].second);
+      }
+    return std::numeric_limits<double>::quiet_NaN();  // beyond the calibration
+  };
+  // Bins of x (log, factor 1.5).
+  std::vector<double> edges{0};
+  for (double e = 0.05; e < 50; e *= 1.5) edges.push_back(e);
+  edges.push_back(std::numeric_limits<double>::infinity());
+  std::vector<double> bk(edges.size(), 0), bt(edges.size(), 0), bx(edges.size(), 0);
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    if (b.radii[i] != lv[small]) continue;
+    const double K = superellipsoid_curvature(b.centres[i] + g, ax);
+    const double x = K > 0 ? lam_top * drho / std::sqrt(K) : std::numeric_limits<double>::infinity();
+    const auto j = static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), x) - edges.begin()) - 1;
+    bt[j] += 1, bk[j] += r.status[i] != Screen::screened, bx[j] += std::isfinite(x) ? std::log(x) : 0;
+  }
+  std::cout << "  | x = lambda_top drho / sqrt(K) | small asperities | kept (body) | kept (sphere of same x) |\n  |---|---|---|---|\n";
+  for (std::size_t j = 0; j + 1 < edges.size(); ++j) {
+    if (bt[j] == 0) continue;
+    const double xm = std::exp(bx[j] / bt[j]);
+    const double se = std::sqrt(bk[j] / bt[j] * (1 - bk[j] / bt[j]) / bt[j]);
+    std::cout << "  | " << edges[j] << " - " << edges[j + 1] << " | " << bt[j] << " | " << bk[j] / bt[j] << " +- " << se << " | "
+              << f(xm) << " |\n";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -156,6 +268,7 @@ int main(int argc, char** argv) {
   mesh->add_option("--speed", me.speed, "impact speed [m/s]");
   mesh->add_option("--omega-x", omega_x, "spin before [rad/s]");
   mesh->add_option("--seed", me.seed, "seed");
+  mesh->add_option("--screen-bodies", me.screen_bodies, "unequal radii: bodies screened (screen_body)");
   mesh->add_option("--out", me.out, "output directory");
   mesh->add_flag("--no-plots", mesh_no_plots, "no PNG figures");
 
@@ -199,6 +312,21 @@ int main(int argc, char** argv) {
   bounce->add_option("--seed", be.seed, "seed");
   bounce->add_option("--out", be.out, "output directory");
   bounce->add_flag("--no-plots", b_no_plots, "no PNG figures");
+
+  std::filesystem::path sc_mesh;
+  std::string sc_smooth, sc_levels = "1.3e-6:0.2,6.5e-7:0.8";
+  std::uint64_t sc_n = 100000, sc_dirs = 400000, sc_seed = 1;
+  int sc_repeats = 3;
+  bool sc_cal = false;
+  auto* scr = app.add_subcommand("screen", "screening of a smooth mesh body (screen_body): kept per level, timing, curvature");
+  scr->add_option("--mesh", sc_mesh, "mesh file")->required();
+  scr->add_option("--smooth", sc_smooth, "a,b,c[,m] [m]")->required();
+  scr->add_option("--n", sc_n, "asperities");
+  scr->add_option("--levels", sc_levels, "radius:fraction,... [m]");
+  scr->add_option("--repeats", sc_repeats, "timing repeats (median)");
+  scr->add_option("--directions", sc_dirs, "random directions of the cross-check");
+  scr->add_option("--seed", sc_seed, "seed");
+  scr->add_flag("--calibrate", sc_cal, "screen spheres of the same lambda (several R) to predict the curvature dependence");
 
   std::vector<std::uint64_t> sb_n{10000, 100000, 1000000};
   std::uint64_t sb_queries = 20000;
@@ -250,6 +378,12 @@ int main(int argc, char** argv) {
       std::cerr << "\n";
       std::cout << format_table(r);
       write_driver_report(be.out, "bounce", to_json(r), format_table(r));
+      return 0;
+    }
+    if (*scr) {
+      const auto ax = parse_list(sc_smooth, "--smooth");
+      if (ax.size() != 3 && ax.size() != 4) throw std::invalid_argument("--smooth needs a,b,c[,m]");
+      screen_run(sc_mesh, ax, sc_n, parse_levels(sc_levels), std::max(1, sc_repeats), sc_dirs, sc_cal, sc_seed);
       return 0;
     }
     if (*sbench) {

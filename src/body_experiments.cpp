@@ -418,6 +418,8 @@ void validate(const MeshImpactExperiment& e) {
   if (!std::isfinite(e.speed) || e.speed <= 0) throw std::invalid_argument("speed must be finite and > 0 m/s, got " + num(e.speed));
   if (!e.omega.allFinite()) throw std::invalid_argument("omega must be finite");
   if (!(e.alpha > 0 && e.alpha < 1)) throw std::invalid_argument("alpha must be in (0,1), got " + num(e.alpha));
+  if (e.screen_bodies > 0 && e.screen_directions < 1)
+    throw std::invalid_argument("screen_directions must be >= 1 when screen_bodies > 0, got 0");
 }
 
 MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress& progress) {
@@ -445,10 +447,36 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress&
   const std::string name = e.mesh.stem().string();
   r.seconds_mesh = seconds_since(ts);
   ts = std::chrono::steady_clock::now();
+  // Screening (screen_body) of the first bodies when the radii differ.
+  const auto& rd = e.radii;
+  const bool unequal = (rd.kind == RadiusDistribution::Kind::lognormal && rd.sigma > 0) ||
+                       (rd.kind == RadiusDistribution::Kind::levels &&
+                        *std::min_element(rd.levels.begin(), rd.levels.end()) != *std::max_element(rd.levels.begin(), rd.levels.end()));
+  MeshScreening& scr = r.screening;
+  if (rd.kind == RadiusDistribution::Kind::levels) scr.levels = rd.levels;
+  std::vector<double> scr_lam, scr_kept(scr.levels.size(), 0), scr_total(scr.levels.size(), 0);
   for (std::uint64_t k = 0; k < e.bodies; ++k) {
     const RoughBody b = make_rough_mesh_body(mesh, e.asperities, e.radii, e.density, e.seed, k, onto, name);
     if (k == 0) r.mass.area = b.area;
     const auto q = make_support_tree(b.centres, b.radii);
+    if (unequal && k < e.screen_bodies) {
+      const auto t_screen = std::chrono::steady_clock::now();
+      const ScreeningResult s = screen_body(b, *q);
+      const ScreeningCheck c = check_screening(b, *q, s, e.screen_directions, e.seed + k);
+      ++scr.bodies;
+      scr.lambda = s.lambda;
+      scr_lam.push_back(s.lambda_eff);
+      scr.witnessed += s.witnessed, scr.helly += s.helly, scr.screened += s.screened;
+      scr.mean_competitors += s.mean_competitors;
+      scr.directions += c.directions, scr.winners_screened += c.winners_screened, scr.kept_never_hit += c.kept_never_hit;
+      for (std::size_t i = 0; i < b.size(); ++i) {
+        const auto m = static_cast<std::size_t>(std::find(scr.levels.begin(), scr.levels.end(), b.radii[i]) - scr.levels.begin());
+        if (m >= scr.levels.size()) continue;
+        scr_total[m] += 1;
+        scr_kept[m] += s.status[i] != Screen::screened;
+      }
+      scr.seconds += seconds_since(t_screen);
+    }
     for_drops(M, k * M, e.drops, progress, [&](std::uint64_t j) {
       const std::uint64_t drop = k * M + j;
       Stream st(e.seed, Purpose::orientation, drop);
@@ -474,6 +502,18 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress&
         wx[drop] = bi.result->Omega_after.x();
       }
     });
+  }
+  if (scr.bodies > 0) {
+    const double nb = static_cast<double>(scr.bodies);
+    scr.mean_competitors /= nb;
+    scr.kept_fraction = static_cast<double>(scr.witnessed + scr.helly) / (nb * static_cast<double>(e.asperities));
+    for (std::size_t m = 0; m < scr.levels.size(); ++m)
+      scr.kept_fraction_by_level.push_back(scr_total[m] > 0 ? scr_kept[m] / scr_total[m] : kNaN);
+    double mean = 0, var = 0;
+    for (double x : scr_lam) mean += x / nb;
+    for (double x : scr_lam) var += (x - mean) * (x - mean);
+    scr.lambda_eff.value = mean;
+    scr.lambda_eff.se = scr.bodies > 1 ? std::sqrt(var / (nb - 1) / nb) : kNaN;
   }
   r.seconds_drops = seconds_since(ts);
   ts = std::chrono::steady_clock::now();
@@ -593,6 +633,14 @@ std::string format_table(const MeshImpactReport& r) {
   os << "comparison sphere: R = " << r.law_radius << " m, N = " << r.law_asperities << " (same areal density)\n";
   os << "drops " << r.samples << ", no impact " << r.no_impacts << ", base surface lower than every asperity "
      << r.core_contacts << "\n";
+  if (const auto& s = r.screening; s.bodies > 0) {
+    os << "screening (" << s.bodies << " bodies): lambda = " << s.lambda << ", lambda_eff = " << s.lambda_eff.value << " +- "
+       << s.lambda_eff.se << " 1/m^2, kept fraction " << s.kept_fraction << ", by level:";
+    for (double f : s.kept_fraction_by_level) os << " " << f;
+    os << "\n  witnessed " << s.witnessed << ", kept without proof " << s.helly << ", screened " << s.screened
+       << ", mean competitors " << s.mean_competitors << ", " << s.seconds << " s; cross-check: " << s.directions
+       << " random directions, winners screened " << s.winners_screened << ", kept but never hit " << s.kept_never_hit << "\n";
+  }
   os << std::left << std::setw(15) << "quantity" << std::setw(24) << "mean +- se" << std::setw(13) << "std" << "q01 / q50 / q99\n";
   for (const auto& q : r.quantities) {
     std::ostringstream m;
@@ -638,6 +686,21 @@ std::string to_json(const MeshImpactReport& r) {
                                {"batches", q.summary.batches}});
   add_tests(j, r.tests, r.plots);
   j["seconds"] = r.seconds;
+  if (const auto& s = r.screening; s.bodies > 0)
+    j["screening"] = {{"bodies", s.bodies},
+                      {"lambda", s.lambda},
+                      {"lambda_eff", json_of(s.lambda_eff)},
+                      {"levels", s.levels},
+                      {"kept_fraction_by_level", s.kept_fraction_by_level},
+                      {"kept_fraction", s.kept_fraction},
+                      {"witnessed", s.witnessed},
+                      {"helly", s.helly},
+                      {"screened", s.screened},
+                      {"mean_competitors", s.mean_competitors},
+                      {"directions", s.directions},
+                      {"winners_screened", s.winners_screened},
+                      {"kept_never_hit", s.kept_never_hit},
+                      {"seconds", s.seconds}};
   return j.dump(2) + "\n";
 }
 

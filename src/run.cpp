@@ -31,6 +31,7 @@ MeshImpactExperiment mesh_experiment(const Scene& s) {
   m.smooth_ellipsoid = s.mesh->smooth;
   m.asperities = e.sphere.asperities;
   m.radii = s.radii ? s.radii->radii : RadiusDistribution::fixed(e.sphere.asperity_radius);
+  if (s.radii) m.screen_bodies = s.radii->screen_bodies, m.screen_directions = s.radii->screen_directions;
   m.density = e.impact.density;
   m.bodies = e.spheres;
   m.drops = e.drops;

@@ -399,11 +399,11 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
              "ensemble.backend: mesh bodies and unequal asperity radii use the exact support tree; only \"auto\", got \"" +
                  std::string(to_string(e.backend)) + "\"");
 
-  // [screening]: unequal radii on a sphere only.
+  // [screening]: unequal radii (sphere: lambda_eff of run_radii_experiment; mesh: screen_body).
   if (auto scr = top.table("screening")) {
-    if (!s.radii || s.mesh)
+    if (!s.radii)
       scr->fail(nullptr, "screening", "screening: only for unequal asperity radii (asperities.radius distribution "
-                                      "\"levels\" or \"lognormal\") on a sphere body");
+                                      "\"levels\" or \"lognormal\")");
     if (auto b = scr->count("bodies", 1, 1u << 20)) s.radii->screen_bodies = *b;
     if (auto d = scr->count("directions", 1, kMaxDrops)) s.radii->screen_directions = *d;
     scr->finish();
@@ -703,7 +703,7 @@ std::string to_toml(const Scene& s) {
     os << "radius = { distribution = \"levels\", radii = " << list(d.levels) << ", fractions = " << list(d.fractions)
        << " }\n\n";
   }
-  if (s.radii && !s.mesh)
+  if (s.radii)
     os << "[screening]\nbodies = " << s.radii->screen_bodies << "\ndirections = " << s.radii->screen_directions << "\n\n";
   os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\n";
   if (e.mode == Mode::fixed) os << "spheres = " << e.spheres << "\n";  // fresh mode has no explicit spheres

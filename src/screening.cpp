@@ -5,11 +5,15 @@
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "asperity/random.hpp"
 
@@ -215,6 +219,157 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
   }
   r.kept = r.witnessed + r.helly;
   r.lambda_eff = static_cast<double>(r.kept) / r.area;
+  r.mean_competitors = n ? comp_sum / static_cast<double>(n) : 0.0;
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const BodyScreeningOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (o.neighbours < 3) throw std::invalid_argument("screen_body: neighbours must be >= 3, got " + std::to_string(o.neighbours));
+  if (o.max_rounds < 1) throw std::invalid_argument("screen_body: max_rounds must be >= 1, got 0");
+  if (b.radii.size() != b.centres.size())
+    throw std::invalid_argument("screen_body: body '" + b.name + "' has " + std::to_string(b.centres.size()) + " centres but " +
+                                std::to_string(b.radii.size()) + " radii");
+  const std::size_t n = b.size();
+  ScreeningResult r;
+  r.status.assign(n, Screen::helly);
+  r.area = b.area > 0 ? b.area : (b.base_radius > 0 ? 4.0 * std::numbers::pi * b.base_radius * b.base_radius : 0.0);
+  r.lambda = r.area > 0 ? static_cast<double>(n) / r.area : 0.0;
+  r.theta_cover = std::numeric_limits<double>::quiet_NaN();
+  // Small bodies: every asperity competes (also covers hand-made bodies without an area).
+  const bool all_compete = n <= 64 || !(r.area > 0);
+  const double L0 = all_compete ? 0.0 : std::sqrt(o.neighbours * r.area / (std::numbers::pi * static_cast<double>(n)));
+  std::vector<std::uint32_t> ncomp(n, 0);
+
+  const auto N = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (std::int64_t jj = 0; jj < N; ++jj) {
+    const auto j = static_cast<std::uint32_t>(jj);
+    const Vec3& cj = b.centres[j];
+    const double rj = b.radii[j];
+    std::vector<std::uint32_t> nb;
+    if (all_compete) {
+      nb.resize(n);
+      for (std::size_t i = 0; i < n; ++i) nb[i] = static_cast<std::uint32_t>(i);
+    } else {
+      double L = L0;
+      for (int t = 0; t < 8; ++t, L *= 2) {
+        nb = q.within(cj, L);
+        if (nb.size() >= 4) break;
+      }
+    }
+    // Start direction: normal of the local centre cloud (smallest principal axis), outward.
+    Vec3 nj = cj.squaredNorm() > 0 ? Vec3(cj.normalized()) : Vec3(0, 0, 1);
+    if (nb.size() >= 3) {
+      Vec3 mean = Vec3::Zero();
+      for (std::uint32_t i : nb) mean += b.centres[i];
+      mean /= static_cast<double>(nb.size());
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (std::uint32_t i : nb) cov += (b.centres[i] - mean) * (b.centres[i] - mean).transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+      es.computeDirect(cov);
+      const Vec3 v = es.eigenvectors().col(0);
+      if (v.allFinite() && v.squaredNorm() > 0.5) nj = v.normalized();
+    }
+    if (nj.dot(cj) < 0) nj = -nj;
+
+    std::vector<HalfSpace> comp;
+    std::vector<std::uint32_t> ids;
+    comp.reserve(nb.size() + o.max_rounds);
+    for (std::uint32_t i : nb) {
+      if (i == j) continue;
+      comp.push_back({cj - b.centres[i], b.radii[i] - rj});
+      ids.push_back(i);
+    }
+    // Projections onto the most violated half-space, back on the sphere; true once d is in C^S.
+    auto relax = [&](Vec3& d, int iterations) {
+      for (int it = 0; it < iterations; ++it) {
+        double worst = 0;
+        const HalfSpace* w = nullptr;
+        for (const HalfSpace& h : comp) {
+          const double v = h.n.dot(d) - h.beta;
+          if (v < worst) worst = v, w = &h;
+        }
+        if (!w) return true;
+        // Over-relaxed projection ON the sphere: rotate d towards the plane's normal a, by 1.5 times
+        // the angle that puts it on the boundary (a chord step then a normalisation converges
+        // slowly when the allowed cap is small).
+        const double an = w->n.norm();
+        if (!(an > 0) || w->beta > an) return false;  // infeasible on its own
+        const Vec3 ah = w->n / an;
+        const double c = ah.dot(d);
+        Vec3 t = d - c * ah;
+        const double tn = t.norm();
+        const double phi = std::atan2(tn, c), phit = std::acos(std::max(-1.0, w->beta / an));
+        const double phin = std::max(0.0, phi - 1.5 * (phi - phit) - 1e-13);
+        d = std::cos(phin) * ah + (tn > 0 ? (std::sin(phin) / tn) * t : Vec3(ah.unitOrthogonal() * std::sin(phin)));
+      }
+      return false;
+    };
+    Vec3 d = nj;
+    bool won = false;
+    for (std::uint32_t round = 0; round < o.max_rounds; ++round) {
+      // Even where the relaxation has not converged (thin cells), the winner at d is a competitor
+      // worth adding: the set grows towards the asperities that close j's cell.
+      const bool feasible = relax(d, round == 0 ? 200 : 48);
+      const Support sp = q.support(d);
+      if (feasible && support_value(cj, rj, d) >= sp.h) {
+        won = true;
+        break;
+      }
+      // No progress: the winner is already a competitor (d violates its half-space, or rounding).
+      if (sp.index == j || std::find(ids.begin(), ids.end(), sp.index) != ids.end()) break;
+      comp.push_back({cj - b.centres[sp.index], b.radii[sp.index] - rj});
+      ids.push_back(sp.index);
+    }
+    ncomp[j] = static_cast<std::uint32_t>(comp.size());
+    if (won) {
+      r.status[j] = Screen::witness;
+      continue;
+    }
+    // x = 0 satisfies every half-space with beta <= 0: C^S meets B, no triple can fail.
+    if (std::all_of(comp.begin(), comp.end(), [](const HalfSpace& h) { return h.beta <= 0; })) continue;
+    // Most violated at d first, as an angle (far competitors have long normals): certificates come early.
+    std::vector<std::pair<double, std::size_t>> order(comp.size());
+    for (std::size_t i = 0; i < comp.size(); ++i) {
+      const double an = comp[i].n.norm();
+      order[i] = {an > 0 ? (comp[i].beta - comp[i].n.dot(d)) / an : std::numeric_limits<double>::infinity(), i};
+    }
+    std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
+    {
+      std::vector<HalfSpace> sorted(comp.size());
+      for (std::size_t i = 0; i < comp.size(); ++i) sorted[i] = comp[order[i].second];
+      comp.swap(sorted);
+    }
+    const int k = static_cast<int>(comp.size());
+    bool screened = false;
+    if (k < 3) {
+      screened = !ball_meets(comp.data(), k);
+    } else {
+      HalfSpace hs[3];
+      for (int z = 2; z < k && !screened; ++z)
+        for (int y = 1; y < z && !screened; ++y)
+          for (int x = 0; x < y && !screened; ++x) {
+            hs[0] = comp[static_cast<std::size_t>(x)];
+            hs[1] = comp[static_cast<std::size_t>(y)];
+            hs[2] = comp[static_cast<std::size_t>(z)];
+            screened = !ball_meets(hs, 3);
+          }
+    }
+    if (screened) r.status[j] = Screen::screened;
+  }
+  double comp_sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    comp_sum += ncomp[i];
+    switch (r.status[i]) {
+      case Screen::screened: ++r.screened; break;
+      case Screen::witness: ++r.witnessed; break;
+      case Screen::helly: ++r.helly; break;
+    }
+  }
+  r.kept = r.witnessed + r.helly;
+  r.lambda_eff = r.area > 0 ? static_cast<double>(r.kept) / r.area : 0.0;
   r.mean_competitors = n ? comp_sum / static_cast<double>(n) : 0.0;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

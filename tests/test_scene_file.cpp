@@ -369,6 +369,13 @@ TEST(SceneFileBodies, ExampleScenesParseIntoTheExpectedFields) {
   EXPECT_TRUE(ln.radii->radii == RadiusDistribution::lognormal(6.5e-7, 0.3));
   const Scene dflt = parse_scene(replace(kLevels, "[screening]\nbodies = 2\ndirections = 1000\n", ""));
   EXPECT_TRUE(dflt.radii == RadiiScene{RadiusDistribution::discrete({1.3e-6, 6.5e-7}, {0.2, 0.8})});
+  // [screening] on a mesh body with unequal radii (screen_body of its first bodies).
+  const Scene ms = parse_scene(replace(kMesh, "radius = { distribution = \"fixed\", value = 6.5e-7 }",
+                                       "radius = { distribution = \"levels\", radii = [1.3e-6, 6.5e-7], fractions = [0.2, 0.8] }") +
+                               "[screening]\nbodies = 1\ndirections = 5000\n");
+  ASSERT_TRUE(ms.mesh.has_value() && ms.radii.has_value());
+  EXPECT_EQ(ms.radii->screen_bodies, 1u);
+  EXPECT_EQ(ms.radii->screen_directions, 5000u);
   // parse_scene does not touch the file system: the path stays as written.
   EXPECT_EQ(parse_scene(kMesh).mesh->file, "../meshes/ellipsoid.off");
 }
@@ -432,6 +439,7 @@ TEST(SceneFileBodies, BadKeysInTheNewSectionsNameTheKeyAndValue) {
   EXPECT_EQ(parse_scene(replace(kLevels, "plots = false", "plots = false\nreport = \"x.json\""), "t").report, "x.json");
   expect_error(replace(kMesh, "plots = false", "plots = false\nrestitution = false"), "outputs.restitution");
   expect_error(kGood + "[screening]\nbodies = 2\n", "screening");
+  expect_error(kMesh + "[screening]\nbodies = 2\n", "screening");  // equal radii: nothing to screen
   expect_error(replace(lognormal("median = 6.5e-7, sigma = 0.3"), "drops = 3000", "drops = 3001"), "ensemble.drops", "3001");
   // A mesh file that is not there: load_scene names the key and the value.
   const auto f = std::filesystem::temp_directory_path() / "asperity-scene-nomesh.toml";

@@ -104,12 +104,28 @@ struct MeshImpactExperiment {
   double alpha = 0.01;
   bool plots = true;
   std::filesystem::path out = "asperity-mesh";
+  std::uint64_t screen_bodies = 2;         ///< unequal radii: the first bodies screened (screen_body); 0: none
+  std::uint64_t screen_directions = 200000;  ///< random directions of the screening cross-check, per body
 };
 void validate(const MeshImpactExperiment& e);
 
 struct NamedSummary {
   std::string name;  ///< "r_x", "r_y", "r_z", "r_xy" [m], "eps" [1], "omega_x_after" [rad/s]
   Summary summary;   ///< se from batch means over the K bodies
+};
+
+/// Screening of the first bodies of a mesh run (screening.hpp, screen_body); pooled over them.
+struct MeshScreening {
+  std::uint64_t bodies = 0;         ///< 0: not run (equal radii, or screen_bodies = 0)
+  double lambda = 0;                ///< N / mesh surface area [1/m^2]
+  Estimate lambda_eff;              ///< kept per mesh surface area, mean over bodies (se over bodies) [1/m^2]
+  std::vector<double> levels;       ///< level radii [m] (levels only)
+  std::vector<double> kept_fraction_by_level;  ///< kept/total per level, pooled
+  double kept_fraction = 0;         ///< kept/total, pooled
+  std::uint64_t witnessed = 0, helly = 0, screened = 0;  ///< helly: kept without a proof
+  double mean_competitors = 0;
+  std::uint64_t directions = 0, winners_screened = 0, kept_never_hit = 0;  ///< cross-check (must: 0 winners screened)
+  double seconds = 0;
 };
 
 struct MeshImpactReport {
@@ -126,6 +142,8 @@ struct MeshImpactReport {
   double seconds = 0;               ///< the whole run [s]
   /// Wall seconds: mesh and mass properties, K bodies x M impacts, summaries and tests, figures.
   double seconds_mesh = 0, seconds_drops = 0, seconds_analysis = 0, seconds_plots = 0;
+
+  MeshScreening screening;          ///< unequal radii only
 
   bool rejected() const;
 };

@@ -6,10 +6,11 @@
 // Euler's equations J_b w' = (J_b w) x w.
 //
 // The motion is solved exactly (Jacobi elliptic functions for the body-frame angular velocity, and
-// the angle about L by quadrature), not integrated step by step: `at(t)` is a pure function of t,
-// so any time can be asked in any order (root finding for the next contact goes back and forth),
-// with an error that does not grow with the number of calls. Degenerate cases (spherical and
-// symmetric tops, the separatrix, rest) have their own closed forms.
+// the angle about L by Gauss-Legendre quadrature of a periodic integrand), not integrated step by
+// step: `at(t)` is a pure function of t, so any time can be asked in any order (root finding for
+// the next contact goes back and forth), with an error that does not grow with the number of
+// calls. Degenerate cases (spherical and symmetric tops, principal axes, the separatrix, rest) are
+// exact cases of the same formulas (no switching thresholds); src/free_rotation.cpp derives them.
 //
 // Frames and units: q maps body to world (orientation.hpp), Omega is the WORLD-frame angular
 // velocity [rad/s], J_b the body-frame inertia about the centre of mass [kg m^2], t [s].
@@ -39,7 +40,11 @@ class FreeRotation {
   FreeRotation(const Eigen::Matrix3d& inertia_body, const Rotation& q0, const Vec3& omega0);
 
   /// The state at time t (t may be negative). Exact up to the rounding of the elliptic functions
-  /// and of the quadrature (relative ~1e-13 per rotation period).
+  /// and of the quadrature: L and T are conserved to ~1e-14 relative at any t; against an Odeint
+  /// integration the state agrees to the integrator's own error (5e-11 over <= 20 periods,
+  /// tests/test_free_rotation.cpp). Near the separatrix (k' = sqrt(1 - k^2) -> 0) the motion is
+  /// ill-conditioned and the phase error grows like eps / k'^2 per period. Costs 3-30 us.
+  /// Thread-safe (no mutable state).
   RotationState at(double t) const;
 
   /// Period of the body-frame angular velocity [s]: 4 K(k) / omega_p (2 pi / omega_p for a
