@@ -122,10 +122,10 @@ TEST(BodyBounce, WorkIdentityAndFlightEnergyInSequences) {
                                 make_rough_sphere_body(sp, RadiusDistribution::discrete({2e-6, 5e-7}, {0.2, 0.8}), 3, 0)};
   BodyBounceOptions o;
   o.bounce.variants = {BounceVariant::dynamic};
-  o.bounce.sequences = 6;
+  o.bounce.sequences = 9;
   o.bounce.speed = 0.6;
   o.bounce.stop_speed = 0.2;
-  o.bounce.max_impacts = 12;
+  o.bounce.max_impacts = 40;
   const BodyBounceSamples s = run_body_bounces(bodies, o, 5, 2);
   ASSERT_GE(s.base.eps.size(), 12u);
   int gains = 0;
@@ -252,10 +252,10 @@ TEST(BodyBounce, OneAndTwoThreadsAreBitIdentical) {
                                 rough_ellipsoid(2000, 4e-3, 3e-3, 2.25e-3, 5e-7, 6)};
   BodyBounceOptions o;
   o.bounce.variants = {BounceVariant::dynamic};
-  o.bounce.sequences = 6;
+  o.bounce.sequences = 8;
   o.bounce.speed = 0.5;
   o.bounce.stop_speed = 0.2;
-  o.bounce.max_impacts = 8;
+  o.bounce.max_impacts = 20;
   o.bounce.omega = Vec3(1, 2, 0);
   const auto a = run_body_bounces(bodies, o, 3, 1), c = run_body_bounces(bodies, o, 3, 2);
   EXPECT_EQ(a.base.sequence, c.base.sequence);
