@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "asperity/body_bounce.hpp"
 #include "asperity/body_experiments.hpp"
 #include "asperity/mesh.hpp"
 #include "asperity/report.hpp"
@@ -233,7 +234,7 @@ void screen_run(const std::filesystem::path& file, const std::vector<double>& ax
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"asperity experiments beyond the paper: unequal asperities, mesh bodies, PLY export"};
+  CLI::App app{"asperity experiments beyond the paper: unequal asperities, mesh bodies, bounces of bodies, PLY export"};
   app.require_subcommand(1);
 
   RadiiExperiment re;
@@ -284,6 +285,33 @@ int main(int argc, char** argv) {
   exp->add_option("--inflate", ex_inflate, "draw asperities this many times larger (visibility)");
   exp->add_option("--smooth", ex_smooth, "a,b,c: map centres onto this ellipsoid [m]");
   exp->add_option("--seed", ex_seed, "seed");
+
+  MeshBounceExperiment be;
+  std::string b_smooth, b_omega = "0,0,0";
+  double b_radius = 5e-7;
+  bool b_no_plots = false;
+  be.options.bounce.variants = {BounceVariant::dynamic};
+  be.options.bounce.sequences = 1000;
+  be.options.bounce.speed = 1.0;
+  be.options.bounce.stop_speed = 0.1;
+  be.mesh.clear();
+  auto* bounce = app.add_subcommand("bounce", "bounce sequences of a rough body (mesh, or sphere without --mesh)");
+  bounce->add_option("--mesh", be.mesh, "mesh file (OFF/PLY/STL/OBJ, metres); absent: a rough sphere of radius --R");
+  bounce->add_option("--smooth", b_smooth, "a,b,c[,m]: map centres onto |x/a|^m+|y/b|^m+|z/c|^m = 1 [m] (m = 2)");
+  bounce->add_option("--R", be.sphere_radius, "sphere radius [m] (without --mesh)");
+  bounce->add_option("--n", be.asperities, "asperities per body");
+  bounce->add_option("--radius", b_radius, "asperity radius [m]");
+  bounce->add_option("--bodies", be.bodies, "explicit bodies");
+  bounce->add_option("--sequences", be.options.bounce.sequences, "sequences");
+  bounce->add_option("--speed", be.options.bounce.speed, "first impact speed [m/s]");
+  bounce->add_option("--stop-speed", be.options.bounce.stop_speed, "stop below this approach speed [m/s]");
+  bounce->add_option("--omega", b_omega, "wx,wy,wz: spin at the first impact [rad/s]");
+  bounce->add_option("--eps-t", be.options.bounce.eps_t, "tangential restitution");
+  bounce->add_option("--bootstrap", be.options.bounce.bootstrap, "bootstrap replicates of the Eq. 2 fits");
+  bounce->add_option("--threads", be.threads, "threads (0: OpenMP default)");
+  bounce->add_option("--seed", be.seed, "seed");
+  bounce->add_option("--out", be.out, "output directory");
+  bounce->add_flag("--no-plots", b_no_plots, "no PNG figures");
 
   std::filesystem::path sc_mesh;
   std::string sc_smooth, sc_levels = "1.3e-6:0.2,6.5e-7:0.8";
@@ -336,6 +364,20 @@ int main(int argc, char** argv) {
       const MeshImpactReport r = run_mesh_impacts(me);
       std::cout << format_table(r);
       write_driver_report(me.out, "mesh", to_json(r), format_table(r));
+      return 0;
+    }
+    if (*bounce) {
+      if (!b_smooth.empty()) be.smooth = parse_list(b_smooth, "--smooth");
+      const auto w = parse_list(b_omega, "--omega");
+      if (w.size() != 3) throw std::invalid_argument("--omega needs wx,wy,wz, got '" + b_omega + "'");
+      be.options.bounce.omega = Vec3(w[0], w[1], w[2]);
+      be.radii = RadiusDistribution::fixed(b_radius);
+      be.plots = !b_no_plots;
+      const MeshBounceReport r = run_mesh_bounces(
+          be, [](std::uint64_t done, std::uint64_t n) { std::cerr << "\r  sequences " << done << " / " << n << std::flush; });
+      std::cerr << "\n";
+      std::cout << format_table(r);
+      write_driver_report(be.out, "bounce", to_json(r), format_table(r));
       return 0;
     }
     if (*scr) {

@@ -53,6 +53,7 @@ void validate(const BounceExperiment& b) {
   if (b.sequences < 1 || b.sequences > 0xFFFFFFFFull)
     throw std::invalid_argument("bounce: sequences must be in [1, 2^32 - 1], got " + std::to_string(b.sequences));
   pos("speed", b.speed);
+  if (!b.omega.allFinite()) throw std::invalid_argument("bounce: Omega must be finite");
   pos("stop_speed", b.stop_speed);
   if (!(b.stop_speed < b.speed))
     throw std::invalid_argument("bounce: stop_speed " + num(b.stop_speed) + " must be below the first impact speed " + num(b.speed));
@@ -214,6 +215,8 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
                           int threads) {
   validate(sphere);
   validate(b);
+  if (b.omega != Vec3::Zero())
+    throw std::invalid_argument("bounce: the sphere variants start without spin (Omega = 0, Sec. V); Omega is for bodies");
   const auto t0 = Clock::now();
   const auto en = viscoelastic_pade14(b.beta);
   Physics p;

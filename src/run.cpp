@@ -10,6 +10,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "asperity/body_bounce.hpp"
 #include "asperity/body_experiments.hpp"
 #include "asperity/bounce.hpp"
 #include "asperity/mesh.hpp"
@@ -181,6 +182,48 @@ SceneOutput run_bounce(const Scene& s, std::ostream* log) {
   return o;
 }
 
+SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
+  const auto& e = s.ensemble;
+  MeshBounceExperiment m;
+  m.mesh = s.mesh->file;
+  m.scale = s.mesh->scale;
+  m.smooth = s.mesh->smooth;
+  m.asperities = e.sphere.asperities;
+  m.radii = s.radii ? s.radii->radii : RadiusDistribution::fixed(e.sphere.asperity_radius);
+  m.density = e.impact.density;
+  m.bodies = e.spheres;
+  m.seed = e.seed;
+  m.threads = e.threads;
+  m.options.bounce = s.bounce;
+  m.plots = s.plots;
+  m.out = s.out;
+  SceneOutput o;
+  double seconds_export = 0;
+  if (!s.mesh->export_ply.empty()) {
+    const auto t0 = Clock::now();
+    o.files.push_back(s.mesh->export_ply);
+    export_first_body(s, mesh_experiment(s));
+    seconds_export = since(t0);
+  }
+  const MeshBounceReport r = run_mesh_bounces(m, progress);
+  o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
+  o.table = format_table(r);
+  const ReportHeader h = header_of(
+      s, {stage("generate", true, std::to_string(m.bodies) + " rough bodies from the mesh", r.seconds_build),
+          stage("index", true, "one exact support tree per body, shared by the threads", r.seconds_index),
+          stage("bounce", true,
+                "sequences: impacts (3x3 solve), free rotation and conservative advancement to each landing",
+                r.seconds_run),
+          stage("analysis", true, "speed windows, impact numbers, Eq. 2 fits (descriptive), energy checks",
+                r.seconds_analysis),
+          plots_stage(s, r.seconds_plots),
+          stage("export", !s.mesh->export_ply.empty(),
+                s.mesh->export_ply.empty() ? "no outputs.export_ply" : "outputs.export_ply: the first body as PLY",
+                seconds_export)});
+  o.json = with_header(to_json(r), h);
+  return o;
+}
+
 SceneOutput run_sphere(const Scene& s, const Progress& progress) {
   const GeometryReport r = run_scene(s, progress);
   SceneOutput o;
@@ -225,7 +268,7 @@ GeometryReport run_scene(const Scene& s, const Progress& progress) {
 }
 
 RunKind run_kind(const Scene& s) {
-  if (s.bounce.enabled) return RunKind::bounce;
+  if (s.bounce.enabled) return s.mesh ? RunKind::mesh_bounce : RunKind::bounce;
   if (s.mesh) return RunKind::mesh;
   if (s.radii) return RunKind::radii;
   return RunKind::sphere;
@@ -237,6 +280,7 @@ std::string_view to_string(RunKind k) {
     case RunKind::radii: return "radii";
     case RunKind::mesh: return "mesh";
     case RunKind::bounce: return "bounce";
+    case RunKind::mesh_bounce: return "mesh-bounce";
   }
   return "?";
 }
@@ -259,6 +303,7 @@ SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostr
       case RunKind::radii: o = run_radii(s, progress); break;
       case RunKind::mesh: o = run_mesh(s, progress); break;
       case RunKind::bounce: o = run_bounce(s, log); break;
+      case RunKind::mesh_bounce: o = run_mesh_bounce(s, progress); break;
     }
     o.kind = run_kind(s);
     return o;

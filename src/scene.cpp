@@ -37,6 +37,8 @@ void validate(const Scene& s) {
     throw std::invalid_argument("report must be a file name inside out, got '" + s.report + "'");
   if (s.name.empty()) throw std::invalid_argument("name must not be empty");
   if (s.bounce.enabled) validate(s.bounce);
+  if (s.bounce.enabled && !s.mesh && s.bounce.omega != Vec3::Zero())
+    throw std::invalid_argument("bounce: Omega is for mesh bodies; the sphere's variants start without spin (Sec. V)");
   // Mesh bodies and unequal radii are the runs of body_experiments.hpp (also after command-line
   // overrides of a scene file): only the ensembles and experiments those runs have.
   if (s.radii) validate(s.radii->radii);
@@ -45,8 +47,12 @@ void validate(const Scene& s) {
     if (s.ensemble.mode != Mode::fixed)
       throw std::invalid_argument("a mesh body needs mode fixed (explicit bodies x rotations), got " +
                                   std::string(to_string(s.ensemble.mode)));
-    if (!s.ensemble.impact.enabled || s.bounce.enabled)
-      throw std::invalid_argument("a mesh body runs single impacts: it needs an impact experiment");
+    if (s.ensemble.impact.enabled == s.bounce.enabled)
+      throw std::invalid_argument("a mesh body runs single impacts or bounce sequences: it needs an impact or a bounce "
+                                  "experiment");
+    if (s.bounce.enabled && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
+      throw std::invalid_argument("a mesh body bounces with its orientation carried by the free rotation: variants must "
+                                  "be \"dynamic\" only");
   } else if (s.radii) {
     // As the scene file checks it, also after --radius: every level (the lognormal median) below R.
     const auto& d = s.radii->radii;

@@ -390,8 +390,6 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     top.fail(nullptr, "ensemble.mode",
              "ensemble.mode: a mesh body needs mode = \"fixed\" (ensemble.spheres explicit bodies x rotations), got \"" +
                  std::string(to_string(e.mode)) + "\"");
-  if (s.mesh && s.ensemble.drops % s.ensemble.spheres != 0)
-    top.fail(nullptr, "ensemble.drops", "ensemble.drops: must be a multiple of ensemble.spheres");
   if (s.radii && !s.mesh && e.mode != Mode::fresh)
     top.fail(nullptr, "ensemble.mode",
              "ensemble.mode: unequal asperity radii on a sphere draw fresh spheres (mode = \"fresh\") and screen "
@@ -443,6 +441,15 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
       }
       if (!(s.bounce.stop_speed < s.bounce.speed))
         ex->bad("stop_speed", "must be below speed = " + num(s.bounce.speed) + " m/s, got " + num(s.bounce.stop_speed));
+      // A body bounces one way: its orientation carried by the free rotation (body_bounce.hpp).
+      if (s.mesh) {
+        if (ex->has("variants") && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
+          ex->bad("variants", "a mesh body bounces with its orientation carried by the free rotation: only \"dynamic\"");
+        s.bounce.variants = {BounceVariant::dynamic};
+        if (const auto W = ex->vec3("Omega", "rad/s")) s.bounce.omega = *W;
+      } else if (ex->has("Omega")) {
+        ex->bad("Omega", "only for body.kind = \"mesh\": the sphere's bounce variants start without spin (Sec. V)");
+      }
     } else {
       for (const char* k : {"speed", "stop_speed", "gravity", "sequences", "variants"})
         if (ex->has(k)) ex->bad(k, "only for kind = \"bounce\"");
@@ -459,13 +466,18 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
       impact.omega = *Omega;
     } else {
       for (const char* k : {"V", "Omega"})
-        if (ex->has(k)) ex->bad(k, "only for kind = \"impact\"");
+        if (ex->has(k) && !(s.bounce.enabled && s.mesh && std::string(k) == "Omega"))
+          ex->bad(k, s.bounce.enabled ? "only for kind = \"impact\" (a bounce starts at V = [0, 0, -speed])"
+                                      : "only for kind = \"impact\"");
     }
     ex->finish();
   }
   impact.enabled = impacts;
-  if (s.mesh && !impacts)
-    top.fail(nullptr, "experiment.kind", "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega)");
+  if (s.mesh && !impacts && !s.bounce.enabled)
+    top.fail(nullptr, "experiment.kind",
+             "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega) or \"bounce\"");
+  if (s.mesh && impacts && s.ensemble.drops % s.ensemble.spheres != 0)
+    top.fail(nullptr, "ensemble.drops", "ensemble.drops: must be a multiple of ensemble.spheres");
   if (s.radii && !s.mesh && (impacts || s.bounce.enabled))
     top.fail(nullptr, "experiment.kind",
              "experiment.kind: unequal asperity radii on a sphere are analysed as contacts only; use kind = \"contact\"");
@@ -707,7 +719,9 @@ std::string to_toml(const Scene& s) {
     os << "[experiment]\nkind = \"bounce\"\nspeed = " << num(b.speed) << "\nstop_speed = " << num(b.stop_speed)
        << "\ngravity = " << num(b.gravity) << "\nsequences = " << b.sequences << "\nvariants = \"";
     for (std::size_t i = 0; i < b.variants.size(); ++i) os << (i ? "," : "") << to_string(b.variants[i]);
-    os << "\"\n\n";
+    os << "\"\n";
+    if (s.mesh) os << "Omega = [" << num(b.omega.x()) << ", " << num(b.omega.y()) << ", " << num(b.omega.z()) << "]\n";
+    os << "\n";
   } else if (x.enabled) {
     os << "[experiment]\nkind = \"impact\"\nV = [0.0, 0.0, " << num(-x.speed) << "]\nOmega = [" << num(x.omega.x())
        << ", " << num(x.omega.y()) << ", " << num(x.omega.z()) << "]\n\n";

@@ -528,3 +528,41 @@ TEST(CliReport, AFailedReportWriteRemovesWhatTheRunWrote) {
 }
 
 }  // namespace
+
+// A mesh body's bounce sequences (body_bounce.hpp) from a scene file: exit 0 (measurements), the
+// common header with the effective scene, the body-bounce fields, figures when asked; the CLI's
+// --sequences / --omega-x override the file, --variant other than dynamic is refused (exit 2).
+TEST(CliScene, MeshBounceSceneRunsBounceSequences) {
+  const fs::path out = fresh_dir("mesh-bounce");
+  const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
+  const fs::path scene = write_scene("mb", "format = 1\nname = \"mb\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
+                                               "\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[asperities]\ncount = 3000\n"
+                                               "[ensemble]\nmode = \"fixed\"\nspheres = 2\n"
+                                               "[experiment]\nkind = \"bounce\"\nspeed = 0.5\nstop_speed = 0.2\n"
+                                               "sequences = 6\nOmega = [1.0, 0.0, 0.0]\n"
+                                               "[outputs]\nplots = true\ndir = \"" + out.string() + "\"\n");
+  const CliRun r = run("--scene " + scene.string() + " --sequences 4 --omega-x 2");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = read_report(out / "report.json");
+  expect_common_header(j, "mb+custom");  // --omega-x changed the physics
+  EXPECT_EQ(j.at("mode"), "body-bounce");
+  EXPECT_EQ(j.at("bounce").at("variants").at(0).at("sequences"), 4);
+  EXPECT_EQ(j.at("bounce").at("omega_rad_s").at(0), 2.0);
+  const auto& b = j.at("bounce").at("body");
+  EXPECT_LT(b.at("work_identity_max_rel").get<double>(), 1e-12);
+  EXPECT_LT(b.at("flight_energy_max_rel").get<double>(), 1e-12);
+  EXPECT_GT(b.at("support_queries_per_flight").get<double>(), 1.0);
+  EXPECT_EQ(b.at("stops").at("slow").get<int>() + b.at("stops").at("no_approach").get<int>() +
+                b.at("stops").at("max_impacts").get<int>() + b.at("stops").at("max_time").get<int>() +
+                b.at("stops").at("max_steps").get<int>(),
+            4);
+  EXPECT_TRUE(fs::exists(out / "report.txt"));
+  EXPECT_TRUE(fs::exists(out / "eps_vs_speed.png"));
+  fs::remove_all(out);
+  const CliRun v = run("--scene " + scene.string() + " --variant paper");
+  EXPECT_EQ(v.status, 2) << v.out;
+  EXPECT_NE(v.out.find("dynamic"), std::string::npos) << v.out;
+  EXPECT_FALSE(fs::exists(out / "report.json"));
+  fs::remove_all(out);
+  fs::remove(scene);
+}

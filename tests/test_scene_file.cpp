@@ -461,3 +461,38 @@ TEST(SceneFileBodies, BadKeysInTheNewSectionsNameTheKeyAndValue) {
   EXPECT_TRUE(std::filesystem::is_regular_file(load_scene(f).mesh->file));
   std::filesystem::remove(f);
 }
+
+namespace {
+const std::string kMeshBounce = replace(replace(kMesh, "drops = 200\n", ""),
+                                        "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]",
+                                        "kind = \"bounce\"\nspeed = 1.0\nstop_speed = 0.1\nsequences = 20\nOmega = [1.0, 2.0, 0.0]");
+}  // namespace
+
+// Mesh bodies bounce (body_bounce.hpp): experiment.kind = "bounce" on a mesh body, Omega at the first
+// impact (bodies only), the one body variant "dynamic"; what cannot apply names the key.
+TEST(SceneFileBodies, MeshBounceScenes) {
+  const Scene s = parse_scene(kMeshBounce);
+  ASSERT_TRUE(s.mesh.has_value());
+  EXPECT_TRUE(s.bounce.enabled);
+  EXPECT_FALSE(s.ensemble.impact.enabled);
+  EXPECT_EQ(s.bounce.omega, Vec3(1.0, 2.0, 0.0));
+  EXPECT_EQ(s.bounce.sequences, 20u);
+  EXPECT_EQ(s.bounce.variants, std::vector<BounceVariant>{BounceVariant::dynamic});
+  const Scene ex = load_scene(kScenes / "ellipsoid-bounce.toml");
+  EXPECT_TRUE(ex.bounce.enabled && ex.mesh.has_value());
+  EXPECT_EQ(ex.ensemble.spheres, 4u);
+  expect_round_trips({s, ex});
+  EXPECT_EQ(parse_scene(replace(kMeshBounce, "sequences = 20", "sequences = 20\nvariants = \"dynamic\"")), s);
+  expect_error(replace(kMeshBounce, "sequences = 20", "sequences = 20\nvariants = \"paper\""), "experiment.variants", "dynamic");
+  expect_error(replace(kMeshBounce, "sequences = 20", "sequences = 20\nvariants = \"dynamic,paper\""), "experiment.variants");
+  expect_error(replace(kMeshBounce, "Omega = [1.0, 2.0, 0.0]", "Omega = [1.0, nan, 0.0]"), "experiment.Omega", "nan");
+  expect_error(replace(kMeshBounce, "speed = 1.0", "speed = 1.0\nV = [0, 0, -1]"), "experiment.V", "impact");
+  // The sphere's bounce variants start without spin.
+  expect_error(replace(kGood, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]", "kind = \"bounce\""), "experiment.Omega", "mesh");
+  Scene bad = s;
+  bad.bounce.variants = {BounceVariant::paper};
+  EXPECT_THROW(validate(bad), std::invalid_argument);
+  Scene sphere = preset("fig6");
+  sphere.bounce.omega = Vec3(0.1, 0, 0);
+  EXPECT_THROW(validate(sphere), std::invalid_argument);
+}

@@ -49,7 +49,10 @@ struct BounceExperiment {
   bool enabled = false;
   std::vector<BounceVariant> variants{BounceVariant::paper, BounceVariant::random_orientation, BounceVariant::dynamic};
   std::uint64_t sequences = 100000;
-  double speed = 1.0;        ///< first impact speed -V_z [m/s] (Omega = 0)
+  double speed = 1.0;        ///< first impact speed -V_z [m/s]
+  /// Spin at the first impact, world frame [rad/s]: bodies only (body_bounce.hpp); the sphere
+  /// variants start without spin (Sec. V), run_bounces refuses anything else.
+  Vec3 omega{0, 0, 0};
   double stop_speed = 0.1;   ///< the sequence ends before the first impact slower than this [m/s]
   double gravity = 9.81;     ///< [m/s^2]
   double density = 7850;     ///< [kg/m^3] (eps does not depend on it)

@@ -22,7 +22,8 @@ enum class RunKind {
   sphere,  ///< the paper's sphere: contacts and single impacts (run_scene)
   radii,   ///< unequal asperity radii on a sphere (run_radii_experiment)
   mesh,    ///< a rough mesh body, single impacts (run_mesh_impacts)
-  bounce   ///< Sec. V bouncing ball (run_bounce_experiment)
+  bounce,  ///< Sec. V bouncing ball (run_bounce_experiment)
+  mesh_bounce  ///< bounce sequences of a rough mesh body (run_mesh_bounces, body_bounce.hpp)
 };
 RunKind run_kind(const Scene& s);
 std::string_view to_string(RunKind k);

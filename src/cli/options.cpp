@@ -132,7 +132,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     }
     if (given("--spheres")) {
       e.spheres = parse_count("--spheres", spheres);
-      if (bounce || radii)
+      if ((bounce && !mesh) || radii)
         refuse("--spheres", "not used by " + kind + (radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
       if (!mesh && e.mode != Mode::fixed)
         refuse("--spheres", "only for fixed mode (explicit spheres x rotations); fresh mode draws a new sphere per drop: "
@@ -159,9 +159,14 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", omega_y);
     if (given("--omega-x") || given("--omega-y")) {
       const std::string opt = given("--omega-x") ? "--omega-x" : "--omega-y";
-      if (bounce) refuse(opt, "not used by " + kind + ": every sequence starts without spin (Omega = 0, Sec. V)");
+      if (bounce && mesh) {  // a mesh body's bounce starts with experiment.Omega
+        if (given("--omega-x")) scene.bounce.omega.x() = e.impact.omega.x();
+        if (given("--omega-y")) scene.bounce.omega.y() = e.impact.omega.y();
+      } else if (bounce) {
+        refuse(opt, "not used by " + kind + ": every sequence starts without spin (Omega = 0, Sec. V)");
+      }
       if (radii) refuse(opt, kind + " is analysed as contacts only (no impacts)");
-      if (!e.impact.enabled)
+      if (!e.impact.enabled && !(bounce && mesh))
         refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
     }
     if (given("--backend")) {
