@@ -450,6 +450,22 @@ TEST(CliProgress, ShownOnlyWhenTheRunIsLong) {
     EXPECT_NE(text.find("100% (100 / 100)"), std::string::npos) << text;
     std::fclose(f);
   }
+  // Bounce runs count sequences, and say so.
+  {
+    std::FILE* g = std::tmpfile();
+    ASSERT_NE(g, nullptr);
+    now = 100.0;
+    asperity::cli::ProgressLine seq(true, g, false, [&] { return now; }, 1.0, "sequences");
+    now = 102.0;
+    seq(3, 4);
+    std::fflush(g);
+    std::rewind(g);
+    char buf[256] = {};
+    const std::string text(buf, std::fread(buf, 1, sizeof buf - 1, g));
+    EXPECT_NE(text.find("sequences: 75% (3 / 4)"), std::string::npos) << text;
+    EXPECT_EQ(text.find("drops"), std::string::npos) << text;
+    std::fclose(g);
+  }
   // Disabled (--quiet): nothing, however long.
   std::FILE* f = std::tmpfile();
   asperity::cli::ProgressLine quiet(false, f, false, [&] { return now; });

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <string>
 
 namespace asperity::cli {
 
@@ -20,8 +21,9 @@ class ProgressLine {
   }
 
   explicit ProgressLine(bool enabled, std::FILE* out = stderr, bool tty = ::isatty(2) != 0,
-                        Clock clock = &ProgressLine::steady_seconds, double quiet_for_s = 1.0)
-      : on_(enabled), tty_(tty), out_(out), clock_(std::move(clock)), quiet_for_(quiet_for_s), start_(clock_()) {}
+                        Clock clock = &ProgressLine::steady_seconds, double quiet_for_s = 1.0, std::string unit = "drops")
+      : on_(enabled), tty_(tty), out_(out), clock_(std::move(clock)), quiet_for_(quiet_for_s), start_(clock_()),
+        unit_(std::move(unit)) {}
 
   void operator()(std::uint64_t done, std::uint64_t total) {
     if (!on_ || total == 0) return;
@@ -30,11 +32,11 @@ class ProgressLine {
     const int pct = static_cast<int>(100.0 * double(done) / double(total));
     if (tty_) {
       if (shown_ && now - last_ < 0.25 && done < total) return;
-      std::fprintf(out_, "\r  drops: %3d%% (%llu / %llu), %.1f s", pct, (unsigned long long)done,
+      std::fprintf(out_, "\r  %s: %3d%% (%llu / %llu), %.1f s", unit_.c_str(), pct, (unsigned long long)done,
                    (unsigned long long)total, elapsed);
       shown_ = true;
     } else if (pct >= next_pct_) {
-      std::fprintf(out_, "  drops: %d%% (%llu / %llu), %.1f s\n", pct, (unsigned long long)done,
+      std::fprintf(out_, "  %s: %d%% (%llu / %llu), %.1f s\n", unit_.c_str(), pct, (unsigned long long)done,
                    (unsigned long long)total, elapsed);
       next_pct_ = pct / 10 * 10 + 10;
     }
@@ -52,6 +54,7 @@ class ProgressLine {
   Clock clock_;
   double quiet_for_;
   double start_, last_ = 0;
+  std::string unit_;  // what is counted: "drops", or "sequences" for bounce runs
   bool shown_ = false;
   int next_pct_ = 10;
 };

@@ -92,7 +92,9 @@ int main(int argc, char** argv) {
     for (const auto& p : written) fs::remove(p, ec);
   };
   try {
-    ProgressLine progress(!quiet);
+    const bool sequences = run_kind(scene) == RunKind::mesh_bounce || run_kind(scene) == RunKind::bounce;
+    ProgressLine progress(!quiet, stderr, ::isatty(2) != 0, &ProgressLine::steady_seconds, 1.0,
+                          sequences ? "sequences" : "drops");
     const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &std::cerr);
     progress.finish();
     for (const auto& f : r.files) written.push_back(scene.out / f);
