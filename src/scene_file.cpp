@@ -379,6 +379,9 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     if (auto b = ens->choice("backend", {"auto", "brute", "kdtree", "cgal", "fcl", "grid"})) {
       s.backend_auto = *b == "auto";
       if (!s.backend_auto) e.backend = parse_backend(*b);
+      if (e.mode == Mode::fresh && !s.backend_auto)  // a key that cannot apply is refused, never ignored
+        ens->bad("backend", "only mode = \"fixed\" queries a contact index (fresh mode draws the lowest asperities "
+                            "exactly): \"auto\" or absent, got \"" + *b + "\"");
     }
     if (auto t = ens->count("threads", 0, 4096)) e.threads = static_cast<int>(*t);
     ens->finish();
@@ -712,7 +715,7 @@ std::string to_toml(const Scene& s) {
     os << quote(std::to_string(e.seed));
   else
     os << e.seed;
-  os << "\nbackend = \"" << (s.backend_auto ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
+  os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::fresh ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
      << e.threads << "\n\n";
   if (s.bounce.enabled) {
     const auto& b = s.bounce;

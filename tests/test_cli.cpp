@@ -380,6 +380,20 @@ TEST(CliReport, AsperityRadiusOverridesLevelRadii) {
 
 // An option that cannot apply to the scene's kind of run is an error naming the option and why,
 // with exit status 2 and nothing written; never silently ignored.
+// --mode fresh on a fixed scene with a chosen backend: the backend no longer applies, so the
+// effective scene says "auto" (and reads back: a fresh scene file naming a backend is an error).
+TEST(CliReport, ModeFreshDropsTheFilesBackend) {
+  const fs::path out = fresh_dir("fresh-backend");
+  const CliRun r = run("--preset fig3-fixed --mode fresh --asperities 1000 --drops 2000 --no-plots --out " +
+                       out.string());
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto j = read_report(out / "report.json");
+  const std::string toml = j.at("scene_file").get<std::string>();
+  EXPECT_NE(toml.find("backend = \"auto\""), std::string::npos) << toml;
+  EXPECT_NO_THROW(asperity::parse_scene(toml));
+  fs::remove_all(out);
+}
+
 TEST(CliReport, OptionsThatCannotApplyAreErrors) {
   const fs::path out = fresh_dir("noapply");
   const fs::path lv = levels_scene(out), mesh = mesh_scene(out);

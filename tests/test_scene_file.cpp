@@ -149,6 +149,10 @@ TEST(SceneFile, RoundTripsThroughToToml) {
   Scene fresh_with_spheres = preset("fig3");
   fresh_with_spheres.ensemble.spheres = 100;  // e.g. fig3-fixed --mode fresh
   EXPECT_EQ(parse_scene(to_toml(fresh_with_spheres)).ensemble.spheres, 1u);
+  Scene fresh_with_backend = preset("fig3");
+  fresh_with_backend.ensemble.backend = Backend::grid;
+  fresh_with_backend.backend_auto = false;
+  EXPECT_TRUE(parse_scene(to_toml(fresh_with_backend)).backend_auto);
   expect_round_trips(scenes);
 }
 
@@ -223,6 +227,10 @@ TEST(SceneFile, NanInfAndOutOfRangeValuesAreErrorsNamingKeyAndValue) {
   expect_error("name = \"x\"\n", "format");
   expect_error(replace(kGood, "mode = \"fixed\"", "mode = \"frozen\""), "ensemble.mode", "frozen");
   expect_error(replace(kGood, "backend = \"auto\"", "backend = \"octree\""), "ensemble.backend", "octree");
+  // A backend in fresh mode would be ignored: refused, naming the key and the value.
+  const std::string fresh = replace(replace(kGood, "mode = \"fixed\"", "mode = \"fresh\""), "spheres = 10", "spheres = 1");
+  EXPECT_NO_THROW(parse_scene(fresh));
+  expect_error(replace(fresh, "backend = \"auto\"", "backend = \"grid\""), "ensemble.backend", "grid");
   expect_error(replace(replace(kGood, "mode = \"fixed\"", "mode = \"fresh\""), "drops = 2000", "drops = 2000"),
                "ensemble.spheres", "fresh");
   expect_error(replace(kGood, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"contact\""),

@@ -123,6 +123,8 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     }
     if (given("--mode")) {
       e.mode = parse_mode(mode);
+      // A backend the file chose for its explicit spheres does not apply to fresh drops.
+      if (e.mode == Mode::fresh && !given("--backend")) scene.backend_auto = true;
       if (bounce) refuse("--mode", "not used by " + kind + ": every sequence bounces its own sphere");
       if (mesh && e.mode != Mode::fixed)
         refuse("--mode", "'" + mode + "': " + kind + " runs explicit bodies x rotations: only \"fixed\"");
