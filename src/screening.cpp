@@ -106,6 +106,44 @@ bool ball_meets(const HalfSpace* hs, int m) {
   return best <= 1.0 + 1e-10;
 }
 
+// Helly in R^3: the ball, the `fixed` half-spaces (0 or 1) and the competitors have an empty
+// intersection iff the ball, the fixed ones and some THREE competitors do (all of them if fewer).
+bool some_triple_misses_ball(const HalfSpace* fixed, int nfixed, const std::vector<HalfSpace>& comp) {
+  HalfSpace hs[4];
+  for (int i = 0; i < nfixed; ++i) hs[i] = fixed[i];
+  const int k = static_cast<int>(comp.size());
+  if (k < 3) {
+    for (int i = 0; i < k; ++i) hs[nfixed + i] = comp[static_cast<std::size_t>(i)];
+    return !ball_meets(hs, nfixed + k);
+  }
+  for (int z = 2; z < k; ++z)
+    for (int y = 1; y < z; ++y)
+      for (int x = 0; x < y; ++x) {
+        hs[nfixed] = comp[static_cast<std::size_t>(x)];
+        hs[nfixed + 1] = comp[static_cast<std::size_t>(y)];
+        hs[nfixed + 2] = comp[static_cast<std::size_t>(z)];
+        if (!ball_meets(hs, nfixed + 3)) return true;
+      }
+  return false;
+}
+
+// Counts by status, lambda_eff and the mean number of competitors.
+void tally(ScreeningResult& r, const std::vector<std::uint32_t>& ncomp) {
+  const std::size_t n = ncomp.size();
+  double comp_sum = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    comp_sum += ncomp[i];
+    switch (r.status[i]) {
+      case Screen::screened: ++r.screened; break;
+      case Screen::witness: ++r.witnessed; break;
+      case Screen::helly: ++r.helly; break;
+    }
+  }
+  r.kept = r.witnessed + r.helly;
+  r.lambda_eff = r.area > 0 ? static_cast<double>(r.kept) / r.area : 0.0;
+  r.mean_competitors = n ? comp_sum / static_cast<double>(n) : 0.0;
+}
+
 }  // namespace
 
 ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
@@ -189,37 +227,10 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
       continue;
     }
     // Helly: the unit ball, the region half-space and every triple of competitors.
-    HalfSpace hs[4];
-    hs[0] = {uj, c};
-    const int k = static_cast<int>(comp.size());
-    bool screened = false;
-    if (k < 3) {
-      for (int i = 0; i < k; ++i) hs[1 + i] = comp[static_cast<std::size_t>(i)];
-      screened = !ball_meets(hs, 1 + k);
-    } else {
-      for (int z = 2; z < k && !screened; ++z)
-        for (int y = 1; y < z && !screened; ++y)
-          for (int x = 0; x < y && !screened; ++x) {
-            hs[1] = comp[static_cast<std::size_t>(x)];
-            hs[2] = comp[static_cast<std::size_t>(y)];
-            hs[3] = comp[static_cast<std::size_t>(z)];
-            screened = !ball_meets(hs, 4);
-          }
-    }
-    if (screened) r.status[j] = Screen::screened;
+    const HalfSpace region{uj, c};
+    if (some_triple_misses_ball(&region, 1, comp)) r.status[j] = Screen::screened;
   }
-  double comp_sum = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    comp_sum += ncomp[i];
-    switch (r.status[i]) {
-      case Screen::screened: ++r.screened; break;
-      case Screen::witness: ++r.witnessed; break;
-      case Screen::helly: ++r.helly; break;
-    }
-  }
-  r.kept = r.witnessed + r.helly;
-  r.lambda_eff = static_cast<double>(r.kept) / r.area;
-  r.mean_competitors = n ? comp_sum / static_cast<double>(n) : 0.0;
+  tally(r, ncomp);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
@@ -342,35 +353,9 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
       for (std::size_t i = 0; i < comp.size(); ++i) sorted[i] = comp[order[i].second];
       comp.swap(sorted);
     }
-    const int k = static_cast<int>(comp.size());
-    bool screened = false;
-    if (k < 3) {
-      screened = !ball_meets(comp.data(), k);
-    } else {
-      HalfSpace hs[3];
-      for (int z = 2; z < k && !screened; ++z)
-        for (int y = 1; y < z && !screened; ++y)
-          for (int x = 0; x < y && !screened; ++x) {
-            hs[0] = comp[static_cast<std::size_t>(x)];
-            hs[1] = comp[static_cast<std::size_t>(y)];
-            hs[2] = comp[static_cast<std::size_t>(z)];
-            screened = !ball_meets(hs, 3);
-          }
-    }
-    if (screened) r.status[j] = Screen::screened;
+    if (some_triple_misses_ball(nullptr, 0, comp)) r.status[j] = Screen::screened;
   }
-  double comp_sum = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    comp_sum += ncomp[i];
-    switch (r.status[i]) {
-      case Screen::screened: ++r.screened; break;
-      case Screen::witness: ++r.witnessed; break;
-      case Screen::helly: ++r.helly; break;
-    }
-  }
-  r.kept = r.witnessed + r.helly;
-  r.lambda_eff = r.area > 0 ? static_cast<double>(r.kept) / r.area : 0.0;
-  r.mean_competitors = n ? comp_sum / static_cast<double>(n) : 0.0;
+  tally(r, ncomp);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }
