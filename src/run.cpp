@@ -88,6 +88,11 @@ PlanStage plots_stage(const Scene& s, double seconds) {
   return stage("plots", s.plots, s.plots ? "outputs.plots" : "plots = false / --no-plots", seconds);
 }
 
+PlanStage export_stage(const Scene& s, double seconds) {
+  const bool on = !s.mesh->export_ply.empty();
+  return stage("export", on, on ? "outputs.export_ply: the first body as PLY" : "no outputs.export_ply", seconds);
+}
+
 // The first body of a mesh run (same seed and index as the run's body 0) as PLY.
 void export_first_body(const Scene& s, const MeshImpactExperiment& m) {
   const TriangleMesh mesh = read_mesh(m.mesh, m.scale);
@@ -147,9 +152,7 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress) {
           stage("analysis", true, "summaries; the sphere laws of the equal-volume sphere (measurements)",
                 r.seconds_analysis),
           plots_stage(s, r.seconds_plots),
-          stage("export", !s.mesh->export_ply.empty(),
-                s.mesh->export_ply.empty() ? "no outputs.export_ply" : "outputs.export_ply: the first body as PLY",
-                seconds_export)});
+          export_stage(s, seconds_export)});
   o.json = with_header(to_json(r), h);
   return o;
 }
@@ -217,9 +220,7 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
           stage("analysis", true, "speed windows, impact numbers, Eq. 2 fits (descriptive), energy checks",
                 r.seconds_analysis),
           plots_stage(s, r.seconds_plots),
-          stage("export", !s.mesh->export_ply.empty(),
-                s.mesh->export_ply.empty() ? "no outputs.export_ply" : "outputs.export_ply: the first body as PLY",
-                seconds_export)});
+          export_stage(s, seconds_export)});
   o.json = with_header(to_json(r), h);
   return o;
 }
