@@ -421,8 +421,17 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
   std::ostringstream o;
   o.imbue(std::locale::classic());
   char line[512];
+  // Rates in units of a power of ten set by the largest left rate: ~1e5 for the rough sphere (the
+  // roughness scatter), ~1e1 for a mesh body (the shape scatter). c can diverge (one-sided law).
+  double a_max = 0;
+  for (const auto& r : reports)
+    for (const auto& g : r.groups)
+      if (g.fitted && std::isfinite(g.fit.a.value)) a_max = std::max(a_max, g.fit.a.value);
+  const int e10 = a_max > 0 ? static_cast<int>(std::floor(std::log10(a_max))) : 5;
+  const double unit = std::pow(10.0, e10);
+  const std::string scale = "[1e" + std::to_string(e10) + "]";
   std::snprintf(line, sizeof line, "%-18s %-13s %8s %6s %-22s %-24s %-18s %-18s %8s %6s\n", "variant", "group", "n", "<u>",
-                "<eps> +- se", "mode m +- se", "a +- se [1e5]", "c +- se [1e5]", "KS D", "p");
+                "<eps> +- se", "mode m +- se", ("a +- se " + scale).c_str(), ("c +- se " + scale).c_str(), "KS D", "p");
   o << line << std::string(150, '-') << "\n";
   for (const auto& r : reports) {
     for (const auto& g : r.groups) {
@@ -431,8 +440,8 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
       std::string m = "-", a = "-", c = "-", D = "-", p = "-";
       if (g.fitted) {
         m = fmt(g.by == "speed" ? "%.3e" : "%.8f", g.fit.m.value) + " +- " + fmt("%.1e", g.fit.m.se);
-        a = fmt("%.3f", g.fit.a.value / 1e5) + " +- " + fmt("%.3f", g.fit.a.se / 1e5);
-        c = fmt("%.3f", g.fit.c.value / 1e5) + " +- " + fmt("%.3f", g.fit.c.se / 1e5);
+        a = fmt("%.3f", g.fit.a.value / unit) + " +- " + fmt("%.3f", g.fit.a.se / unit);
+        c = fmt("%.3f", g.fit.c.value / unit) + " +- " + fmt("%.3f", g.fit.c.se / unit);
         D = fmt("%.4f", g.gof.D), p = fmt("%.2f", g.gof.p);
       }
       std::snprintf(line, sizeof line, "%-18s %-13s %8zu %6.3f %-22s %-24s %-18s %-18s %8s %6s\n",
