@@ -154,7 +154,7 @@ void screen_run(const std::filesystem::path& file, const std::vector<double>& ax
                 int repeats, std::uint64_t directions, bool calibrate, std::uint64_t seed) {
   const TriangleMesh m = read_mesh(file);
   const Vec3 g = mass_properties(m, 1000).centroid;
-  const RoughBody b = make_rough_mesh_body(m, n, rd, 1000, seed, 0, superellipsoid_surface(ax[0], ax[1], ax[2], ax.size() == 4 ? ax[3] : 2.0),
+  const RoughBody b = make_rough_mesh_body(m, n, rd, 1000, seed, 0, smooth_surface(ax),
                                            file.stem().string());
   const auto q = make_support_tree(b.centres, b.radii);
   std::vector<double> secs;
@@ -399,7 +399,7 @@ int main(int argc, char** argv) {
         const auto ax = parse_list(ex_smooth, "--smooth");
         if (ax.size() != 3 && ax.size() != 4)
           throw std::invalid_argument("--smooth needs a,b,c[,m], got " + std::to_string(ax.size()) + " numbers");
-        onto = superellipsoid_surface(ax[0], ax[1], ax[2], ax.size() == 4 ? ax[3] : 2.0);
+        onto = smooth_surface(ax);
       }
       const RoughBody b = make_rough_mesh_body(m, ex_n, RadiusDistribution::fixed(ex_radius), 1000, ex_seed, 0, onto,
                                                ex_mesh.stem().string());

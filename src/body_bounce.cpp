@@ -28,6 +28,7 @@
 
 namespace asperity {
 
+using detail::fmt;
 using detail::num;
 
 namespace {
@@ -348,11 +349,6 @@ void validate(const MeshBounceExperiment& e) {
 
 namespace {
 
-std::string fmt(const char* f, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, x);
-  return buf;
-}
 
 // eps against impact speed: mean +- se and the 10/90% quantiles per speed bin, eps_n(u) of Eq. 9
 // (what a smooth sphere would give) for reference.
@@ -393,9 +389,7 @@ MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e, const Progress&
   std::vector<RoughBody> bodies(static_cast<std::size_t>(e.bodies));
   if (!e.mesh.empty()) {
     const TriangleMesh mesh = read_mesh(e.mesh, e.scale);
-    SurfaceMap onto;
-    if (!e.smooth.empty())
-      onto = superellipsoid_surface(e.smooth[0], e.smooth[1], e.smooth[2], e.smooth.size() == 4 ? e.smooth[3] : 2.0);
+    const SurfaceMap onto = smooth_surface(e.smooth);
     r.body_name = e.mesh.stem().string();
     for (std::uint64_t k = 0; k < e.bodies; ++k)
       bodies[static_cast<std::size_t>(k)] = make_rough_mesh_body(mesh, e.asperities, e.radii, e.density, e.seed, k, onto, r.body_name);

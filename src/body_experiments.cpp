@@ -83,6 +83,32 @@ void for_drops(std::uint64_t n, std::uint64_t offset, std::uint64_t total, const
   }
 }
 
+// Screening pooled over the screened bodies: kept fraction per radius level, and lambda_eff as the
+// mean over bodies with its standard error (the bodies are independent; se NaN for one body).
+struct ScreeningPool {
+  std::vector<double> levels, kept, total, lambda_eff;
+  explicit ScreeningPool(std::vector<double> lv) : levels(std::move(lv)), kept(levels.size(), 0), total(levels.size(), 0) {}
+  void add(const RoughBody& b, const ScreeningResult& s) {
+    lambda_eff.push_back(s.lambda_eff);
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      const auto m = static_cast<std::size_t>(std::find(levels.begin(), levels.end(), b.radii[i]) - levels.begin());
+      if (m >= levels.size()) continue;
+      total[m] += 1;
+      kept[m] += s.status[i] != Screen::screened;
+    }
+  }
+  std::vector<double> kept_fraction_by_level() const {
+    std::vector<double> f;
+    for (std::size_t m = 0; m < levels.size(); ++m) f.push_back(total[m] > 0 ? kept[m] / total[m] : kNaN);
+    return f;
+  }
+  Estimate lambda_eff_mean() const {
+    if (lambda_eff.empty()) return {kNaN, kNaN};
+    if (lambda_eff.size() == 1) return {lambda_eff[0], kNaN};
+    return summarize_iid(lambda_eff, std::vector<double>{}).mean;
+  }
+};
+
 }  // namespace
 
 bool decisive_rejection(const std::vector<LawCheck>& tests) {
@@ -214,14 +240,13 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e, const Progress& progr
   SphereParams p;
   p.asperities = e.asperities;
   p.radius = R;
-  std::vector<double> lam_eff;
-  std::vector<double> kept_by(lv.size(), 0), total_by(lv.size(), 0);
+  ScreeningPool pool(lv);
   for (std::uint64_t k = 0; k < e.screen_bodies; ++k) {
     const RoughBody b = make_rough_sphere_body(p, e.radii, e.seed, k);
     const auto q = make_support_tree(b.centres, b.radii);
     const ScreeningResult s = screen_sphere(b, *q);
     const ScreeningCheck c = check_screening(b, *q, s, e.screen_directions, e.seed + k);
-    lam_eff.push_back(s.lambda_eff);
+    pool.add(b, s);
     if (k == 0) r.theta_cover = s.theta_cover;
     r.mean_competitors += s.mean_competitors / static_cast<double>(e.screen_bodies);
     r.witnessed += s.witnessed;
@@ -242,22 +267,9 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e, const Progress& progr
         rxy_explicit[base + static_cast<std::size_t>(j)] = std::hypot(bc.r.x(), bc.r.y());
       });
     }
-    for (std::size_t i = 0; i < b.size(); ++i) {
-      const std::size_t m = static_cast<std::size_t>(std::find(lv.begin(), lv.end(), b.radii[i]) - lv.begin());
-      if (m >= lv.size()) continue;
-      total_by[m] += 1;
-      kept_by[m] += s.status[i] != Screen::screened;
-    }
   }
-  for (std::size_t m = 0; m < lv.size(); ++m) r.kept_fraction_by_level.push_back(total_by[m] > 0 ? kept_by[m] / total_by[m] : kNaN);
-  if (!lam_eff.empty()) {
-    double m = 0, v = 0;
-    for (double x : lam_eff) m += x;
-    m /= static_cast<double>(lam_eff.size());
-    for (double x : lam_eff) v += (x - m) * (x - m);
-    r.lambda_eff.value = m;
-    r.lambda_eff.se = lam_eff.size() > 1 ? std::sqrt(v / static_cast<double>(lam_eff.size() - 1) / static_cast<double>(lam_eff.size())) : kNaN;
-  }
+  r.kept_fraction_by_level = pool.kept_fraction_by_level();
+  if (!pool.lambda_eff.empty()) r.lambda_eff = pool.lambda_eff_mean();
   r.seconds_screen = seconds_since(t0);
 
   if (lognormal) return finish_lognormal(e, r, rx_explicit, rxy_explicit);
@@ -431,10 +443,8 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress&
   const TriangleMesh mesh = read_mesh(e.mesh, e.scale);
   r.mass = mass_properties(mesh, e.density);
   r.principal_moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(r.mass.inertia).eigenvalues();
-  SurfaceMap onto;
+  const SurfaceMap onto = smooth_surface(e.smooth_ellipsoid);
   const double sm_m = e.smooth_ellipsoid.size() == 4 ? e.smooth_ellipsoid[3] : 2.0;
-  if (!e.smooth_ellipsoid.empty())
-    onto = superellipsoid_surface(e.smooth_ellipsoid[0], e.smooth_ellipsoid[1], e.smooth_ellipsoid[2], sm_m);
   // Comparison sphere: equal volume (the mesh's, or the smooth ellipsoid's).
   r.law_radius = e.smooth_ellipsoid.empty() || sm_m != 2.0
                      ? std::cbrt(3.0 * r.mass.volume / (4.0 * std::numbers::pi))
@@ -454,7 +464,7 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress&
                         *std::min_element(rd.levels.begin(), rd.levels.end()) != *std::max_element(rd.levels.begin(), rd.levels.end()));
   MeshScreening& scr = r.screening;
   if (rd.kind == RadiusDistribution::Kind::levels) scr.levels = rd.levels;
-  std::vector<double> scr_lam, scr_kept(scr.levels.size(), 0), scr_total(scr.levels.size(), 0);
+  ScreeningPool pool(scr.levels);
   for (std::uint64_t k = 0; k < e.bodies; ++k) {
     const RoughBody b = make_rough_mesh_body(mesh, e.asperities, e.radii, e.density, e.seed, k, onto, name);
     if (k == 0) r.mass.area = b.area;
@@ -465,16 +475,10 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress&
       const ScreeningCheck c = check_screening(b, *q, s, e.screen_directions, e.seed + k);
       ++scr.bodies;
       scr.lambda = s.lambda;
-      scr_lam.push_back(s.lambda_eff);
+      pool.add(b, s);
       scr.witnessed += s.witnessed, scr.helly += s.helly, scr.screened += s.screened;
       scr.mean_competitors += s.mean_competitors;
       scr.directions += c.directions, scr.winners_screened += c.winners_screened, scr.kept_never_hit += c.kept_never_hit;
-      for (std::size_t i = 0; i < b.size(); ++i) {
-        const auto m = static_cast<std::size_t>(std::find(scr.levels.begin(), scr.levels.end(), b.radii[i]) - scr.levels.begin());
-        if (m >= scr.levels.size()) continue;
-        scr_total[m] += 1;
-        scr_kept[m] += s.status[i] != Screen::screened;
-      }
       scr.seconds += seconds_since(t_screen);
     }
     for_drops(M, k * M, e.drops, progress, [&](std::uint64_t j) {
@@ -507,13 +511,8 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const Progress&
     const double nb = static_cast<double>(scr.bodies);
     scr.mean_competitors /= nb;
     scr.kept_fraction = static_cast<double>(scr.witnessed + scr.helly) / (nb * static_cast<double>(e.asperities));
-    for (std::size_t m = 0; m < scr.levels.size(); ++m)
-      scr.kept_fraction_by_level.push_back(scr_total[m] > 0 ? scr_kept[m] / scr_total[m] : kNaN);
-    double mean = 0, var = 0;
-    for (double x : scr_lam) mean += x / nb;
-    for (double x : scr_lam) var += (x - mean) * (x - mean);
-    scr.lambda_eff.value = mean;
-    scr.lambda_eff.se = scr.bodies > 1 ? std::sqrt(var / (nb - 1) / nb) : kNaN;
+    scr.kept_fraction_by_level = pool.kept_fraction_by_level();
+    scr.lambda_eff = pool.lambda_eff_mean();
   }
   r.seconds_drops = seconds_since(ts);
   ts = std::chrono::steady_clock::now();

@@ -26,6 +26,7 @@
 
 namespace asperity {
 
+using detail::fmt;
 using detail::num;
 
 std::string_view to_string(BounceVariant v) {
@@ -410,11 +411,6 @@ std::string gp_quote(std::string s) {  // inside '...' gnuplot only needs ' doub
   return s;
 }
 
-std::string fmt(const char* f, double x) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, x);
-  return buf;
-}
 }  // namespace
 
 std::string format_bounce_table(const std::vector<BounceVariantReport>& reports) {

@@ -108,6 +108,14 @@ SurfaceMap superellipsoid_surface(double a, double b, double c, double m) {
   };
 }
 
+SurfaceMap smooth_surface(const std::vector<double>& axes) {
+  if (axes.empty()) return {};
+  if (axes.size() != 3 && axes.size() != 4)
+    throw std::invalid_argument("smooth surface needs semi-axes a, b, c and an optional exponent m, got " +
+                                std::to_string(axes.size()) + " numbers");
+  return superellipsoid_surface(axes[0], axes[1], axes[2], axes.size() == 4 ? axes[3] : 2.0);
+}
+
 RoughBody make_rough_mesh_body(const TriangleMesh& m, std::uint64_t n, const RadiusDistribution& radii, double density,
                                std::uint64_t seed, std::uint64_t body_id, const SurfaceMap& onto, std::string name) {
   validate(radii);

@@ -23,6 +23,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+// Asperity radii of a scene: its distribution, or the paper's one radius.
+RadiusDistribution scene_radii(const Scene& s) {
+  return s.radii ? s.radii->radii : RadiusDistribution::fixed(s.ensemble.sphere.asperity_radius);
+}
+
 MeshImpactExperiment mesh_experiment(const Scene& s) {
   const auto& e = s.ensemble;
   MeshImpactExperiment m;
@@ -30,7 +35,7 @@ MeshImpactExperiment mesh_experiment(const Scene& s) {
   m.scale = s.mesh->scale;
   m.smooth_ellipsoid = s.mesh->smooth;
   m.asperities = e.sphere.asperities;
-  m.radii = s.radii ? s.radii->radii : RadiusDistribution::fixed(e.sphere.asperity_radius);
+  m.radii = scene_radii(s);
   if (s.radii) m.screen_bodies = s.radii->screen_bodies, m.screen_directions = s.radii->screen_directions;
   m.density = e.impact.density;
   m.bodies = e.spheres;
@@ -93,16 +98,14 @@ PlanStage export_stage(const Scene& s, double seconds) {
   return stage("export", on, on ? "outputs.export_ply: the first body as PLY" : "no outputs.export_ply", seconds);
 }
 
-// The first body of a mesh run (same seed and index as the run's body 0) as PLY.
-void export_first_body(const Scene& s, const MeshImpactExperiment& m) {
-  const TriangleMesh mesh = read_mesh(m.mesh, m.scale);
-  SurfaceMap onto;
-  if (!m.smooth_ellipsoid.empty())
-    onto = superellipsoid_surface(m.smooth_ellipsoid[0], m.smooth_ellipsoid[1], m.smooth_ellipsoid[2],
-                                  m.smooth_ellipsoid.size() == 4 ? m.smooth_ellipsoid[3] : 2.0);
-  const RoughBody b = make_rough_mesh_body(mesh, m.asperities, m.radii, m.density, m.seed, 0, onto, m.mesh.stem().string());
+// The first body of a mesh scene (same seed and index as the run's body 0) as PLY.
+void export_first_body(const Scene& s) {
+  const TriangleMesh mesh = read_mesh(s.mesh->file, s.mesh->scale);
+  const double density = s.ensemble.impact.density;
+  const RoughBody b = make_rough_mesh_body(mesh, s.ensemble.sphere.asperities, scene_radii(s), density, s.ensemble.seed, 0,
+                                           smooth_surface(s.mesh->smooth), s.mesh->file.stem().string());
   write_ply(s.out / s.mesh->export_ply, b, s.mesh->export_points ? PlyStyle::points : PlyStyle::spheres, 1.0, &mesh,
-            -mass_properties(mesh, m.density).centroid);
+            -mass_properties(mesh, density).centroid);
 }
 
 SceneOutput run_radii(const Scene& s, const Progress& progress) {
@@ -136,7 +139,7 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress) {
   if (!s.mesh->export_ply.empty()) {
     const auto t0 = Clock::now();
     o.files.push_back(s.mesh->export_ply);  // listed first: removed if anything below fails
-    export_first_body(s, m);
+    export_first_body(s);
     seconds_export = since(t0);
   }
   const MeshImpactReport r = run_mesh_impacts(m, progress);
@@ -192,7 +195,7 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
   m.scale = s.mesh->scale;
   m.smooth = s.mesh->smooth;
   m.asperities = e.sphere.asperities;
-  m.radii = s.radii ? s.radii->radii : RadiusDistribution::fixed(e.sphere.asperity_radius);
+  m.radii = scene_radii(s);
   m.density = e.impact.density;
   m.bodies = e.spheres;
   m.seed = e.seed;
@@ -205,7 +208,7 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
   if (!s.mesh->export_ply.empty()) {
     const auto t0 = Clock::now();
     o.files.push_back(s.mesh->export_ply);
-    export_first_body(s, mesh_experiment(s));
+    export_first_body(s);
     seconds_export = since(t0);
   }
   const MeshBounceReport r = run_mesh_bounces(m, progress);

@@ -46,6 +46,9 @@ SurfaceMap ellipsoid_surface(double a, double b, double c);
 /// Radial projection onto the superellipsoid |x/a|^m + |y/b|^m + |z/c|^m = 1 (m >= 2; m = 2 is
 /// the ellipsoid, meshes/rounded_cube.off is a = b = c = 2.5 mm, m = 8).
 SurfaceMap superellipsoid_surface(double a, double b, double c, double m);
+/// The surface of a scene's `smooth = [a, b, c(, m)]` (m = 2 if absent): empty -> no map (centres
+/// stay on the facets). Throws std::invalid_argument for another count or a bad value.
+SurfaceMap smooth_surface(const std::vector<double>& axes);
 
 /// N asperity centres uniform by area on the mesh surface: triangle by area (cumulative table,
 /// binary search on one uniform), point by the sqrt trick (two uniforms), then the radius
