@@ -301,7 +301,7 @@ TEST(BodyBounce, EnergyIsConservedByTheReversingLawAndNotByEpsT1) {
     const double z = idx->support(body_down(q)).h, g = 9.81;
     const BodyImpact rev = body_impact(b, *idx, q, V, W, *e1, -1.0);
     const BodyImpact pap = body_impact(b, *idx, q, V, W, *e1, 1.0);
-    if (!rev.result) continue;
+    if (!rev.result || !pap.result) continue;
     const double E = body_energy(b, q, V, W, z, g);
     EXPECT_NEAR(body_energy(b, q, rev.result->V_after, rev.result->Omega_after, z, g), E, 1e-12 * E) << i;
     changed += std::abs(body_energy(b, q, pap.result->V_after, pap.result->Omega_after, z, g) - E) > 1e-6 * E;

@@ -408,8 +408,8 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {"--preset fig6 --spheres 2", "--spheres: not used by a bounce run"},
       {"--preset fig6 --backend grid", "--backend: not used by a bounce run"},
       {L + " --mode fixed", "--mode: 'fixed'"},
-      {L + " --speed 1", "--speed"},
-      {L + " --omega-y 1", "--omega-y"},
+      {L + " --speed 1", "--speed: a run with unequal asperity radii on a sphere"},
+      {L + " --omega-y 1", "--omega-y: a run with unequal asperity radii on a sphere"},
       {L + " --backend grid", "--backend: not used by a run with unequal asperity radii"},
       {L + " --spheres 3", "--spheres: not used by a run with unequal asperity radii"},
       {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
@@ -462,6 +462,8 @@ TEST(CliProgress, ShownOnlyWhenTheRunIsLong) {
     EXPECT_NE(text.find("50% (50 / 100), 1.5 s"), std::string::npos) << text;
     EXPECT_EQ(text.find("10 / 100"), std::string::npos) << text;
     EXPECT_NE(text.find("100% (100 / 100)"), std::string::npos) << text;
+    // A terminal gets one line redrawn with \r; a file or pipe gets whole lines.
+    EXPECT_EQ(text.find('\r') != std::string::npos, tty) << text;
     std::fclose(f);
   }
   // Bounce runs count sequences, and say so.

@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <regex>
+#include <unistd.h>
+#include <thread>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,8 +19,9 @@ using namespace asperity;
 
 Scene scene_of(const std::string& text) { return parse_scene(text, "test_run"); }
 
-const std::string kOutputs = "[outputs]\nplots = false\ndir = \"" +
-                             (std::filesystem::temp_directory_path() / "asperity-test-run").string() + "\"\n";
+const std::filesystem::path kOut =
+    std::filesystem::temp_directory_path() / ("asperity-test-run-" + std::to_string(::getpid()));
+const std::string kOutputs = "[outputs]\nplots = false\ndir = \"" + kOut.string() + "\"\n";
 
 Scene levels_scene(const std::string& radius) {
   return scene_of("format = 1\nname = \"lv\"\n[asperities]\ncount = 2000\n" + radius +
@@ -38,8 +41,8 @@ std::string without_clock(std::string text) {
   return std::regex_replace(text, std::regex("\"(seconds[a-z_]*)\": *[-+.0-9eE]+"), "\"$1\": 0");
 }
 
-// Progress goes from the calling thread, never backwards, and ends at (drops, drops); it changes
-// no result (the drops are chunked for it).
+// Progress goes from the calling thread, never backwards, and ends at (drops, drops); a run
+// without a callback gives the same report (the chunking does not depend on the callback).
 TEST(RunSceneOutput, RadiiAndMeshRunsReportProgressAndTheCommonHeader) {
   const std::vector<std::pair<Scene, RunKind>> scenes = {
       {levels_scene("radius = { distribution = \"levels\", radii = [1.3e-6, 6.5e-7], fractions = [0.2, 0.8] }\n"),
@@ -49,7 +52,13 @@ TEST(RunSceneOutput, RadiiAndMeshRunsReportProgressAndTheCommonHeader) {
   for (const auto& [scene, kind] : scenes) {
     EXPECT_EQ(run_kind(scene), kind);
     std::vector<std::pair<std::uint64_t, std::uint64_t>> calls;
-    const SceneOutput a = run_scene_output(scene, [&](std::uint64_t done, std::uint64_t total) { calls.emplace_back(done, total); });
+    bool other_thread = false;
+    const auto caller = std::this_thread::get_id();
+    const SceneOutput a = run_scene_output(scene, [&](std::uint64_t done, std::uint64_t total) {
+      other_thread |= std::this_thread::get_id() != caller;  // callbacks must not come from OpenMP workers
+      calls.emplace_back(done, total);
+    });
+    EXPECT_FALSE(other_thread) << to_string(kind);
     ASSERT_GE(calls.size(), 2u) << to_string(kind);  // 40000 drops are more than one chunk
     for (std::size_t i = 0; i < calls.size(); ++i) {
       EXPECT_EQ(calls[i].second, 40000u);
@@ -68,7 +77,7 @@ TEST(RunSceneOutput, RadiiAndMeshRunsReportProgressAndTheCommonHeader) {
     EXPECT_FALSE(a.table.empty());
     EXPECT_EQ(a.rejected, j.at("rejected").get<bool>());
   }
-  std::filesystem::remove_all(std::filesystem::temp_directory_path() / "asperity-test-run");
+  std::filesystem::remove_all(kOut);
 }
 
 }  // namespace
