@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "asperity/bounce.hpp"
-#include "asperity/contact.hpp"
-#include "asperity/geometry.hpp"
+#include "asperity/experiments/bounce.hpp"
+#include "asperity/core/contact.hpp"
+#include "asperity/core/geometry.hpp"
 
 using namespace asperity;
 using Clock = std::chrono::steady_clock;

@@ -48,11 +48,11 @@
 #include <thread>
 #include <vector>
 
-#include "asperity/contact.hpp"
-#include "asperity/ensemble.hpp"
-#include "asperity/geometry.hpp"
-#include "asperity/orientation.hpp"
-#include "asperity/random.hpp"
+#include "asperity/core/contact.hpp"
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/core/geometry.hpp"
+#include "asperity/core/orientation.hpp"
+#include "asperity/core/random.hpp"
 #include "directions.hpp"
 
 namespace {

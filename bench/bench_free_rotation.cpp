@@ -8,8 +8,8 @@
 #include <cmath>
 #include <vector>
 
-#include "asperity/free_rotation.hpp"
-#include "free_rotation_reference.hpp"
+#include "asperity/core/free_rotation.hpp"
+#include "core/free_rotation_reference.hpp"
 
 using namespace asperity;
 

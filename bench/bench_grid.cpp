@@ -10,10 +10,10 @@
 #include <memory>
 #include <vector>
 
-#include "asperity/contact.hpp"
-#include "asperity/geometry.hpp"
-#include "asperity/random.hpp"
-#include "contact/detail.hpp"
+#include "asperity/core/contact.hpp"
+#include "asperity/core/geometry.hpp"
+#include "asperity/core/random.hpp"
+#include "core/contact/detail.hpp"
 
 namespace {
 

@@ -4,9 +4,9 @@
 
 #include <vector>
 
-#include "asperity/ensemble.hpp"
-#include "asperity/impact.hpp"
-#include "asperity/restitution.hpp"
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/core/impact.hpp"
+#include "asperity/core/restitution.hpp"
 
 using namespace asperity;
 

@@ -26,12 +26,12 @@
 #include <string>
 #include <vector>
 
-#include "asperity/contact.hpp"
-#include "asperity/ensemble.hpp"
-#include "asperity/geometry.hpp"
-#include "asperity/orientation.hpp"
-#include "asperity/statistics.hpp"
-#include "asperity/theory.hpp"
+#include "asperity/core/contact.hpp"
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/core/geometry.hpp"
+#include "asperity/core/orientation.hpp"
+#include "asperity/laws/statistics.hpp"
+#include "asperity/laws/theory.hpp"
 #include "directions.hpp"
 
 namespace {

@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "asperity/plan.hpp"
-#include "asperity/run.hpp"
-#include "asperity/scene.hpp"
+#include "asperity/app/plan.hpp"
+#include "asperity/app/run.hpp"
+#include "asperity/app/scene.hpp"
 
 using namespace asperity;
 using Clock = std::chrono::steady_clock;

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "asperity/geometry.hpp"
-#include "asperity/random.hpp"
+#include "asperity/core/geometry.hpp"
+#include "asperity/core/random.hpp"
 
 namespace asperity::bench {
 

@@ -13,16 +13,20 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
-#include "asperity/body_bounce.hpp"
-#include "asperity/body_experiments.hpp"
-#include "asperity/mesh.hpp"
-#include "asperity/report.hpp"
-#include "asperity/random.hpp"
-#include "asperity/screening.hpp"
-#include "asperity/support.hpp"
+#include "asperity/experiments/body_bounce.hpp"
+#include "asperity/experiments/body_experiments.hpp"
+#include "asperity/core/mesh.hpp"
+#include "asperity/app/experiment_reports.hpp"
+#include "asperity/app/mesh_io.hpp"
+#include "asperity/app/plot.hpp"
+#include "asperity/app/report.hpp"
+#include "asperity/core/random.hpp"
+#include "asperity/core/screening.hpp"
+#include "asperity/core/support.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -238,6 +242,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
 
   RadiiExperiment re;
+  std::filesystem::path re_out = "asperity-radii";
   std::string levels = "1.3e-6:0.2,6.5e-7:0.8";
   bool no_plots = false;
   auto* radii = app.add_subcommand("radii", "screening, lambda_eff and the law of r_x with level radii");
@@ -250,10 +255,11 @@ int main(int argc, char** argv) {
   radii->add_option("--bodies", re.screen_bodies, "explicit spheres screened for lambda_eff");
   radii->add_option("--directions", re.screen_directions, "random directions of the screening cross-check per body");
   radii->add_option("--seed", re.seed, "seed");
-  radii->add_option("--out", re.out, "output directory");
+  radii->add_option("--out", re_out, "output directory");
   radii->add_flag("--no-plots", no_plots, "no PNG figures");
 
   MeshImpactExperiment me;
+  std::filesystem::path me_out = "asperity-mesh";
   std::string mesh_levels, smooth;
   double mesh_radius = 6.5e-7, omega_x = 0.2;
   bool mesh_no_plots = false;
@@ -269,7 +275,7 @@ int main(int argc, char** argv) {
   mesh->add_option("--omega-x", omega_x, "spin before [rad/s]");
   mesh->add_option("--seed", me.seed, "seed");
   mesh->add_option("--screen-bodies", me.screen_bodies, "unequal radii: bodies screened (screen_body)");
-  mesh->add_option("--out", me.out, "output directory");
+  mesh->add_option("--out", me_out, "output directory");
   mesh->add_flag("--no-plots", mesh_no_plots, "no PNG figures");
 
   std::filesystem::path ex_mesh, ex_out;
@@ -287,6 +293,7 @@ int main(int argc, char** argv) {
   exp->add_option("--seed", ex_seed, "seed");
 
   MeshBounceExperiment be;
+  std::filesystem::path be_out = "asperity-bounce";
   std::string b_smooth, b_omega = "0,0,0";
   double b_radius = 5e-7;
   bool b_no_plots = false;
@@ -310,7 +317,7 @@ int main(int argc, char** argv) {
   bounce->add_option("--bootstrap", be.options.bounce.bootstrap, "bootstrap replicates of the Eq. 2 fits");
   bounce->add_option("--threads", be.threads, "threads (0: OpenMP default)");
   bounce->add_option("--seed", be.seed, "seed");
-  bounce->add_option("--out", be.out, "output directory");
+  bounce->add_option("--out", be_out, "output directory");
   bounce->add_flag("--no-plots", b_no_plots, "no PNG figures");
 
   std::filesystem::path sc_mesh;
@@ -351,9 +358,11 @@ int main(int argc, char** argv) {
         re.radii = RadiusDistribution::lognormal(v[0], v[1]);
       }
       re.plots = !no_plots;
-      const RadiiReport r = run_radii_experiment(re);
+      RadiiReport r = run_radii_experiment(re);
+      std::filesystem::create_directories(re_out);
+      if (re.plots) r.plots = write_figures(re_out, r.figures);
       std::cout << format_table(r);
-      write_driver_report(re.out, "radii", to_json(r), format_table(r));
+      write_driver_report(re_out, "radii", to_json(r), format_table(r));
       return 0;
     }
     if (*mesh) {
@@ -361,9 +370,11 @@ int main(int argc, char** argv) {
       me.radii = mesh_levels.empty() ? RadiusDistribution::fixed(mesh_radius) : parse_levels(mesh_levels);
       me.omega = Vec3(omega_x, 0, 0);
       me.plots = !mesh_no_plots;
-      const MeshImpactReport r = run_mesh_impacts(me);
+      MeshImpactReport r = run_mesh_impacts(me, read_mesh(me.mesh, me.scale));
+      std::filesystem::create_directories(me_out);
+      if (me.plots) r.plots = write_figures(me_out, r.figures);
       std::cout << format_table(r);
-      write_driver_report(me.out, "mesh", to_json(r), format_table(r));
+      write_driver_report(me_out, "mesh", to_json(r), format_table(r));
       return 0;
     }
     if (*bounce) {
@@ -373,11 +384,15 @@ int main(int argc, char** argv) {
       be.options.bounce.omega = Vec3(w[0], w[1], w[2]);
       be.radii = RadiusDistribution::fixed(b_radius);
       be.plots = !b_no_plots;
-      const MeshBounceReport r = run_mesh_bounces(
-          be, [](std::uint64_t done, std::uint64_t n) { std::cerr << "\r  sequences " << done << " / " << n << std::flush; });
+      const std::optional<TriangleMesh> base =
+          be.mesh.empty() ? std::nullopt : std::optional<TriangleMesh>(read_mesh(be.mesh, be.scale));
+      MeshBounceReport r = run_mesh_bounces(
+          be, base ? &*base : nullptr, [](std::uint64_t done, std::uint64_t n) { std::cerr << "\r  sequences " << done << " / " << n << std::flush; });
       std::cerr << "\n";
+      std::filesystem::create_directories(be_out);
+      if (be.plots) r.plots = write_mesh_bounce_plots(be_out, r);
       std::cout << format_table(r);
-      write_driver_report(be.out, "bounce", to_json(r), format_table(r));
+      write_driver_report(be_out, "bounce", to_json(r), format_table(r));
       return 0;
     }
     if (*scr) {

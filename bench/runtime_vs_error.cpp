@@ -39,10 +39,10 @@
 
 #include <omp.h>
 
-#include "asperity/ensemble.hpp"
-#include "asperity/random.hpp"
-#include "asperity/statistics.hpp"
-#include "asperity/theory.hpp"
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/core/random.hpp"
+#include "asperity/laws/statistics.hpp"
+#include "asperity/laws/theory.hpp"
 
 namespace {
 

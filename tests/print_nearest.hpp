@@ -2,7 +2,7 @@
 // Readable GoogleTest failure messages for EXPECT_EQ on Nearest.
 #include <ostream>
 
-#include "asperity/contact.hpp"
+#include "asperity/core/contact.hpp"
 
 namespace asperity {
 inline void PrintTo(const Nearest& n, std::ostream* os) {

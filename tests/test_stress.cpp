@@ -12,14 +12,14 @@
 #include <vector>
 
 #include "run_command.hpp"
-#include "asperity/contact.hpp"
-#include "asperity/ensemble.hpp"
-#include "asperity/impact.hpp"
-#include "asperity/orientation.hpp"
-#include "asperity/random.hpp"
-#include "asperity/report.hpp"
-#include "asperity/restitution.hpp"
-#include "asperity/scene.hpp"
+#include "asperity/core/contact.hpp"
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/core/impact.hpp"
+#include "asperity/core/orientation.hpp"
+#include "asperity/core/random.hpp"
+#include "asperity/app/report.hpp"
+#include "asperity/core/restitution.hpp"
+#include "asperity/app/scene.hpp"
 
 using namespace asperity;
 

@@ -1,6 +1,10 @@
-#include <asperity/contact.hpp>
-#include <asperity/geometry.hpp>
+// A downstream DEM contact model: finds the touching asperity and resolves the impulse using only
+// core headers (asperity/core/...), so it builds against asperity::core alone.
+#include <asperity/core/contact.hpp>
+#include <asperity/core/geometry.hpp>
+#include <asperity/core/impact.hpp>
 
+#include <cmath>
 #include <iostream>
 
 int main() {
@@ -10,5 +14,11 @@ int main() {
   const auto n = index->lowest(down);
   const bool ok = n == asperity::brute_lowest(body.centres, down);
   std::cout << "lowest asperity " << n.index << (ok ? " (matches brute force)" : " (MISMATCH)") << "\n";
-  return ok ? 0 : 1;
+
+  asperity::ImpactState s;
+  s.r = 3e-3 * body.centres[n.index];
+  const auto hit = asperity::solve_impact(asperity::RigidBody::sphere(1e-3, 3e-3), s, 0.9);
+  const bool impulse_ok = hit && std::isfinite(hit->eps) && hit->P.z() > 0;
+  std::cout << "impulse " << (impulse_ok ? "resolved" : "FAILED") << "\n";
+  return ok && impulse_ok ? 0 : 1;
 }

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "asperity/scene_file.hpp"
+#include "asperity/app/scene_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size > 16384) return 0;  // scene files are small; keep the fuzzer on syntax, not size

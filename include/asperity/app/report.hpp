@@ -1,0 +1,103 @@
+#pragma once
+// What a run found, as a value: per-quantity summaries, one entry per (quantity, law) test with a
+// verdict, core-contact counts and timings. Rendered as a table for people, as report.json for
+// tools (a versioned contract, see README), and as PNG figures.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/app/plan.hpp"
+#include "asperity/app/atomic_file.hpp"  // write_file_atomic, before it had a header of its own
+#include "asperity/app/scene.hpp"
+#include "asperity/laws/statistics.hpp"
+
+namespace asperity {
+
+inline constexpr int kReportSchemaVersion = 1;
+
+struct QuantityReport {
+  std::string name;  ///< "r_xy", "r_x", "r_y", "r_z" [m]; "eps" [1], "omega_x_after" [rad/s]
+  Summary summary;   ///< SI units (metres)
+};
+
+struct TestReport {
+  std::string quantity;   ///< e.g. "r_xy"
+  std::string law;        ///< "eq14", "exact-sphere", "eq18"
+  std::string scope;      ///< "all" (every drop), "pooled" (fixed: all rotations), "one-per-sphere"
+  std::string statistic;  ///< "KS" or "binomial"
+  double D = 0;           ///< KS distance (NaN for a count test)
+  double p = 1;
+  std::uint64_t n = 0;
+  double predicted_mean = 0;  ///< mean of the quantity under the law (NaN if not applicable)
+  bool iid = true;            ///< whether the p-value's iid assumption holds for these samples
+  bool decisive = true;       ///< counts towards the exit status
+  /// "accept", "reject", "quenched" (fixed: expected deviation), "skipped" (the law could not be
+  /// evaluated: D, p and predicted_mean NaN, the note says why)
+  std::string verdict;
+  std::string note;
+};
+
+struct GeometryReport {
+  Scene scene;
+  std::uint64_t samples = 0;
+  std::uint64_t core_contacts = 0;
+  double core_probability = 0;        ///< exact, per drop
+  double core_probability_paper = 0;  ///< the paper's R* estimate
+  double gap_min = 0, gap_median = 0; ///< runner-up height gap [m]
+  double quenched_scale = 0;          ///< typical KS deviation of one sphere's own law (fixed)
+  std::string ensemble_note;
+  std::vector<QuantityReport> quantities;
+  std::vector<TestReport> tests;
+  std::vector<std::pair<std::string, double>> timings_s;
+  std::vector<std::string> plots;     ///< file names written in the output directory
+  std::size_t index_bytes = 0;
+  // Impact experiments only:
+  std::uint64_t no_impacts = 0;       ///< contacts that did not approach the plate
+  double eps_n_mean = 0;              ///< mean microscopic eps_n
+  Estimate eps_deficit;               ///< eps_n - <eps> with its standard error
+  // Filled by run_scene (run.hpp):
+  std::vector<PlanStage> plan;        ///< every stage, run or skipped with its reason, and its time
+  std::string scene_toml;             ///< the scene that ran, as a scene file (to_toml)
+
+  /// A decisive test rejected its law.
+  bool rejected() const;
+  /// Decisive tests that could not be evaluated (verdict "skipped").
+  std::size_t skipped() const;
+};
+
+/// Summaries and tests of a run: the contact laws only if scene.contact_stats, the restitution laws
+/// only if the samples hold impacts. Sorts copies of the samples; O(n log n).
+GeometryReport analyse(const Scene& scene, const ContactSamples& s);
+
+/// The human-readable table (quantity | measured +- se | law | KS D | p | verdict).
+std::string format_table(const GeometryReport& r);
+
+/// Serialised report.json text.
+std::string to_json(const GeometryReport& r);
+
+/// The fields every report.json has, whatever kind of run wrote it (README "report.json").
+struct ReportHeader {
+  std::string tool = "validate-geometry";
+  std::string scene;                    ///< scene name ("+custom" when the command line overrode it)
+  std::string scene_toml;               ///< the effective scene as a scene file (to_toml); empty: omitted
+  std::vector<PlanStage> plan;          ///< empty: omitted
+  std::vector<std::pair<std::string, double>> timings_s;  ///< wall seconds per stage; empty: omitted
+};
+
+/// `body` (a JSON object, as the to_json functions return it) with the header fields set:
+/// schema_version, tool, scene, and scene_file, plan, timings_s when the header has them.
+/// Fields of `body` are kept, except that the header's values win for these names.
+std::string with_header(const std::string& body, const ReportHeader& h);
+
+/// The one writer of a run's report files: `dir / report_name` (the JSON text) and, next to it,
+/// the table as `<stem>.txt`, each atomically. If either cannot be written, neither is left
+/// behind; throws std::runtime_error naming the file. Returns the paths written.
+std::vector<std::filesystem::path> write_report_files(const std::filesystem::path& dir, const std::string& report_name,
+                                                      const std::string& json, const std::string& table);
+
+/// Writes the PNG figures of r_xy, r_x, r_y against their laws into `dir`; returns file names.
+std::vector<std::string> write_plots(const std::filesystem::path& dir, const Scene& scene, const ContactSamples& s);
+
+}  // namespace asperity

@@ -1,0 +1,49 @@
+#pragma once
+// One call runs a scene as validate-geometry does: plan, ensemble, analysis, figures.
+#include <iosfwd>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/app/plan.hpp"
+#include "asperity/app/report.hpp"
+#include "asperity/app/scene.hpp"
+
+namespace asperity {
+
+/// Runs only the stages make_plan(s) lists (figures are written into s.out when planned; the
+/// report file is not written). The report carries the plan with stage times and the scene as
+/// TOML (to_toml(s)). Throws std::invalid_argument for an invalid scene.
+GeometryReport run_scene(const Scene& s, const Progress& progress = {});
+
+/// The kinds of run a scene can be (README "Scenes").
+enum class RunKind {
+  sphere,  ///< the paper's sphere: contacts and single impacts (run_scene)
+  radii,   ///< unequal asperity radii on a sphere (run_radii_experiment)
+  mesh,    ///< a rough mesh body, single impacts (run_mesh_impacts)
+  bounce,  ///< Sec. V bouncing ball (run_bounce_experiment)
+  mesh_bounce  ///< bounce sequences of a rough mesh body (run_mesh_bounces, body_bounce.hpp)
+};
+RunKind run_kind(const Scene& s);
+std::string_view to_string(RunKind k);
+
+/// What any run produced, ready for the one writer (write_report_files, report.hpp).
+struct SceneOutput {
+  RunKind kind = RunKind::sphere;
+  std::string json;                 ///< report.json text, with the common header (with_header)
+  std::string table;                ///< the table for people (printed, and written as report.txt)
+  std::vector<std::string> files;   ///< files the run wrote into s.out (figures, PLY), by name
+  bool rejected = false;            ///< a decisive test rejected its law (exit status 1)
+  /// Decisive tests that could not be evaluated (verdict "skipped"), one line each with the
+  /// reason; the run still exits 0 unless a law was rejected (README "validate-geometry").
+  std::vector<std::string> skipped;
+};
+
+/// Runs a scene of any kind and renders its report; writes only figures (and the PLY of a mesh
+/// scene's outputs.export_ply) into s.out, never the report files. Progress of the drops goes to
+/// `progress` (sphere, radii, mesh), one line per bounce variant to `log` if given. On an
+/// exception the files this call wrote are removed.
+SceneOutput run_scene_output(const Scene& s, const Progress& progress = {}, std::ostream* log = nullptr);
+
+}  // namespace asperity

@@ -1,0 +1,87 @@
+#pragma once
+// A scene: everything one run of validate-geometry needs, with named presets that reproduce the
+// paper's figures. Every field is validated before any work starts. Scenes are written as TOML
+// files (see scene_file.hpp and README "Scenes"); the presets are such files, embedded in the
+// library at build time from scenes/*.toml.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "asperity/core/body.hpp"
+#include "asperity/experiments/bounce.hpp"
+#include "asperity/experiments/ensemble.hpp"
+
+namespace asperity {
+
+/// A rough body built on a triangle mesh (mesh.hpp) instead of the paper's sphere: a run of
+/// run_mesh_impacts (body_experiments.hpp) -- ensemble.spheres explicit bodies x rotations.
+struct MeshBodyScene {
+  /// As written in the scene; load_scene resolves it (relative to the scene file's directory,
+  /// then to the meshes/ directory of the source tree or installation).
+  std::filesystem::path file;
+  double scale = 1.0;                ///< mesh coordinates -> metres
+  /// Empty: asperity centres on the facets; {a, b, c[, m]} [m]: mapped onto that (super)ellipsoid.
+  std::vector<double> smooth;
+  /// Non-empty: the first body is also written as PLY (asperity spheres) to out / export_ply.
+  std::string export_ply;
+  bool export_points = false;        ///< PLY of centres only (small) instead of asperity spheres
+
+  friend bool operator==(const MeshBodyScene&, const MeshBodyScene&) = default;
+};
+
+/// Unequal asperity radii on the sphere: a run of run_radii_experiment (body_experiments.hpp).
+struct RadiiScene {
+  RadiusDistribution radii;                  ///< levels or lognormal
+  std::uint64_t screen_bodies = 2;           ///< explicit spheres screened for lambda_eff
+  std::uint64_t screen_directions = 200000;  ///< random directions of the screening cross-check, per body
+
+  friend bool operator==(const RadiiScene&, const RadiiScene&) = default;
+};
+
+struct Scene {
+  std::string name = "fig3";  ///< preset name, or "custom"
+  EnsembleConfig ensemble;
+  /// ensemble.backend was not chosen by the user: the planner picks a scan or an index from the
+  /// work per sphere (fixed mode). Results do not depend on the choice (every backend is exact).
+  bool backend_auto = true;
+  double alpha = 0.01;        ///< significance level of each test
+  bool plots = true;          ///< write PNG figures (needs gnuplot)
+  bool contact_stats = true;  ///< analyse r_xy, r_x, r_y, r_z and core contacts against their laws
+  /// Solve the impulse and analyse eps, Omega'_x when the experiment has impacts
+  /// (ensemble.impact.enabled); off: the impact stage is skipped.
+  bool restitution_stats = true;
+  std::filesystem::path out = "asperity-out";
+  std::string report = "report.json";  ///< report file name inside `out`
+
+  friend bool operator==(const Scene&, const Scene&) = default;
+
+  BounceExperiment bounce;    ///< Sec. V bouncing ball (fig6); when enabled, the run is a bounce run
+  /// body.kind = "mesh": the run is run_mesh_impacts (asperity radii from `radii` if set, else
+  /// ensemble.sphere.asperity_radius); ensemble.sphere.radius is unused.
+  std::optional<MeshBodyScene> mesh;
+  /// Asperity radii "levels"/"lognormal"; on a sphere the run is run_radii_experiment.
+  /// nullopt: every asperity has radius ensemble.sphere.asperity_radius (the paper).
+  std::optional<RadiiScene> radii;
+};
+
+/// Names of the built-in presets (the files scenes/NAME.toml, embedded in the library).
+std::vector<std::string> preset_names();
+/// The TOML text of a preset; throws std::invalid_argument naming the value for an unknown name.
+std::string_view preset_text(std::string_view name);
+/// The scene of a preset (parse_scene(preset_text(name))); throws std::invalid_argument naming the
+/// value for an unknown name.
+/// fig3: the paper's Fig. 3 -- N = 1e5, R = 3 mm, a = 6.5e-7 m, fresh spheres, 1e6 drops.
+/// fig3-fixed: the same from 100 explicit spheres x 1e4 rotations (grid backend).
+/// fig4: Fig. 3's sphere dropped at V.n = 1.3 m/s with Omega_x = 0.2 rad/s: eps and Omega'_x.
+/// fig5: Omega = 0, V.n = 1 m/s, a = R x 1e-4: Omega'_x.
+/// fig6: Sec. V bouncing ball, N = 1e6, R = 3 mm, a = 5e-7 m, V_z = 1 m/s, Omega = 0, until
+///       V_z < 0.1 m/s, 1e5 sequences per variant (paper, random-orientation, dynamic).
+Scene preset(std::string_view name);
+
+/// Throws std::invalid_argument naming the offending field and value.
+void validate(const Scene& s);
+
+}  // namespace asperity

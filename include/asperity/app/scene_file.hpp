@@ -1,0 +1,43 @@
+#pragma once
+// Scene files: a versioned TOML format (format = 1) describing one run -- body, material,
+// asperities, ensemble, experiment, outputs. Documented in README "Scenes" and, key by key, in
+// scenes/example.toml. Every key is checked: unknown keys, wrong types, NaN/inf and out-of-range
+// values are errors naming the full dotted key (and the value); features the engine does not have
+// yet (oblique impacts, constant restitution, ...) are errors
+// "not supported yet: <key> = <value>", never silently ignored.
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "asperity/app/scene.hpp"
+
+namespace asperity {
+
+/// The scene format version this library reads and writes.
+inline constexpr int kSceneFormatVersion = 1;
+
+/// A bad scene file: what() is "<origin>:<line>: <key>: <problem>"; key() is the dotted key
+/// ("" for a TOML syntax error).
+class SceneError : public std::invalid_argument {
+ public:
+  SceneError(const std::string& what, std::string key) : std::invalid_argument(what), key_(std::move(key)) {}
+  const std::string& key() const noexcept { return key_; }
+
+ private:
+  std::string key_;
+};
+
+/// Parses and validates a scene. Pure (no file or environment access): `origin` only names the
+/// text in messages. Throws SceneError.
+Scene parse_scene(std::string_view toml_text, std::string_view origin = "scene");
+
+/// Reads and parses a scene file; throws SceneError (also for an unreadable file).
+Scene load_scene(const std::filesystem::path& file);
+
+/// The scene as a format-1 TOML document with every key it uses written: parse_scene(to_toml(s))
+/// == s for every valid scene. Settings a scene does not use are not written and read back as
+/// their defaults: V and Omega of a contact experiment, spheres in fresh mode.
+std::string to_toml(const Scene& s);
+
+}  // namespace asperity

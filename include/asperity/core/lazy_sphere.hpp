@@ -1,0 +1,82 @@
+#pragma once
+// A lazy exact rough sphere: N iid uniform asperity centres on the unit sphere, of which only the
+// part a query touches is ever generated.
+//
+// Construction (exact in law): the sphere is split recursively into cells [z0,z1] x [phi0,phi1];
+// by Archimedes a cell's area is (z1 - z0)(phi1 - phi0), and every split halves z or phi range at
+// the equal-area midpoint, so a cell holding n centres passes Binomial(n, 1/2) of them to its first
+// child. Cells with at most `leaf_size` centres are leaves; their centres are uniform in (z, phi).
+// Every cell's count and every leaf's centres are pure functions of (seed, sphere id, cell id)
+// (Stream(seed, Purpose::lazy_sphere, sphere, 2 id) and 2 id + 1), so the sphere is one fixed
+// sample whatever order queries come in. Indices are global: the centres of a leaf follow those
+// of all leaves left of it (offsets are the counts of left siblings along the path), so
+// materialise() returns the same indexed set a query sees, and lowest() equals brute_lowest on it.
+//
+// Query: best-first descent over cells ordered by an exact lower bound of contact_key over the
+// cell (the maximum of u.d over a (z, phi) cell in closed form, minus a margin of 1e-13 that
+// dominates every rounding error), stopping when no open cell can beat the current runner-up.
+// Generated cells are kept: later queries on the same sphere reuse them. reset() starts a new
+// sphere keeping the memory.
+//
+// Binomial(n, 1/2) is drawn exactly without std::binomial_distribution (whose draws differ
+// between library versions): popcount of n random bits for n <= 512, otherwise inversion that
+// starts at the mode and walks outwards (pmf from lgamma, then exact ratios), O(sqrt n) steps.
+#include <cstdint>
+#include <vector>
+
+#include "asperity/core/contact.hpp"
+#include "asperity/core/geometry.hpp"
+
+namespace asperity {
+
+class Stream;
+
+/// Binomial(n, 1/2) from the stream (exact: popcount for small n, mode-centred inversion above).
+std::uint64_t binomial_half(std::uint64_t n, Stream& s);
+
+struct LazyNearest {
+  Nearest nearest;  ///< as brute_lowest on materialise()
+  Vec3 u{0, 0, 0};  ///< unit centre of the lowest asperity (body frame)
+};
+
+class LazySphere {
+ public:
+  /// N >= 1 (< 2^32, indices are 32-bit) centres; throws std::invalid_argument otherwise.
+  LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size = 8);
+
+  /// Start another sphere (same N): clears the cache, keeps the allocated memory.
+  void reset(std::uint64_t seed, std::uint64_t sphere_id);
+
+  /// The two lowest asperities for the unit body-frame down direction d. Generates and caches
+  /// the cells it needs; not thread-safe (use one LazySphere per thread).
+  LazyNearest lowest(const Vec3& d);
+
+  /// All N centres in index order (generates the whole sphere: tests and small N only).
+  std::vector<Vec3> materialise();
+
+  std::uint64_t size() const { return n_; }
+  std::size_t cells_generated() const { return nodes_.size(); }
+  std::size_t centres_generated() const { return points_.size(); }
+
+ private:
+  struct Node {
+    double z0, z1, p0, p1;
+    std::uint64_t id;      // heap numbering: root 1, children 2 id and 2 id + 1
+    std::uint64_t count;   // centres in the cell
+    std::uint64_t offset;  // global index of its first centre
+    std::int64_t child = -1;   // index of the first child in nodes_ (second = child + 1)
+    std::int64_t points = -1;  // leaves: index of the first centre in points_
+  };
+  bool is_leaf(const Node& c) const { return c.count <= leaf_size_ || c.id >= (std::uint64_t{1} << 60); }
+  void expand(std::size_t i);
+  void fill(std::size_t i);
+  static double lower_key(const Node& c, const Vec3& d, double dxy, double psi);
+
+  std::uint64_t n_, seed_, sphere_;
+  unsigned leaf_size_;
+  std::vector<Node> nodes_;
+  std::vector<Vec3> points_;
+  std::vector<std::pair<double, std::size_t>> heap_;  // scratch of lowest()
+};
+
+}  // namespace asperity

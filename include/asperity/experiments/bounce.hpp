@@ -1,0 +1,171 @@
+#pragma once
+// The bouncing ball of the paper's Sec. V: a rough sphere dropped onto a plate bounces until its
+// impact speed falls below a threshold; the restitution coefficients of all its impacts are
+// collected, grouped, and fitted with the asymmetric Laplace law of Eq. 2 (laplace.hpp).
+//
+// Variants (selectable, reported side by side):
+//  - paper: eps drawn from the corrected Eq. 28 in its generative form eps = eps_n + b^2/(4 alpha)
+//    - alpha W (W/sigma^2 noncentral chi-square, theory_impact.hpp) at the current speed and spin,
+//    Omega'_x from the corrected Eq. 33, drawn independently as the paper does; the next impact
+//    speed is eps times this one (flight conserves |V_z|). Only Omega_x is tracked, as in the paper.
+//  - paper-printed33: the same with Omega'_x from Eq. 33 as printed (6x wider). Eq. 28 as printed
+//    is not a density (negative, or normalised a point mass; docs/sec4-derivations.md) and
+//    cannot be iterated; its corrected form is used in both paper variants.
+//  - random-orientation: explicit geometry and the full impulse (impact.hpp) at every impact, on
+//    one lazy exact sphere per sequence (lazy_sphere.hpp) given a fresh Haar orientation before
+//    every impact: consecutive contacts are independent, as the paper assumes.
+//  - dynamic: the same sphere and impulse, but the orientation is carried by the real rotation
+//    between impacts: q(t) = exp(Omega t) q exactly (isotropic inertia: free rotation is uniform
+//    about the constant Omega), so consecutive contacts are correlated.
+// Flight (explicit variants): the centre lifts off at height h = -r_z (the contact point on the
+// plate), flies ballistically under gravity g, and lands when its lowest point touches: the
+// landing time solves h + V_z t - g t^2/2 = D(q(t)), D the depth of the lowest point below the
+// centre (R (1 - key/2) + a, or R for a core contact), by fixed-point iteration on t (D changes by
+// ~R Omega theta t ~ 1e-11 m over the nanoseconds it shifts t, so it converges in 2-3 steps).
+// The flight times T_k are exact including the height differences of successive contacts; they
+// give eps as the experiment measures it, T_k / T_{k-1}.
+// Frame and units: z up, plate normal +z, SI (m, s, rad/s). Sequence i uses only streams keyed
+// by (seed, i): results are bit-identical for any thread count.
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "asperity/core/geometry.hpp"
+#include "asperity/laws/laplace.hpp"
+#include "asperity/laws/statistics.hpp"
+
+namespace asperity {
+
+enum class BounceVariant { paper, paper_printed33, random_orientation, dynamic };
+std::string_view to_string(BounceVariant v);
+/// "paper", "paper-printed33", "random-orientation", "dynamic"; throws std::invalid_argument naming the value.
+BounceVariant parse_bounce_variant(std::string_view s);
+
+struct BounceExperiment {
+  bool enabled = false;
+  std::vector<BounceVariant> variants{BounceVariant::paper, BounceVariant::random_orientation, BounceVariant::dynamic};
+  std::uint64_t sequences = 100000;
+  double speed = 1.0;        ///< first impact speed -V_z [m/s]
+  /// Spin at the first impact, world frame [rad/s]: bodies only (body_bounce.hpp); the sphere
+  /// variants start without spin (Sec. V), run_bounces refuses anything else.
+  Vec3 omega{0, 0, 0};
+  double stop_speed = 0.1;   ///< the sequence ends before the first impact slower than this [m/s]
+  double gravity = 9.81;     ///< [m/s^2]
+  double density = 7850;     ///< [kg/m^3] (eps does not depend on it)
+  double beta = 0.0467;      ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
+  double eps_t = 1.0;        ///< tangential restitution (paper: 1)
+  unsigned max_impacts = 100000;  ///< safety bound per sequence
+  std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
+                                  ///< max(19, 2e7/n): the work is B n; the count used is reported)
+  /// Impact-speed windows [lo, hi] [m/s] (the unbiased grouping, see BounceReport::grouping_note).
+  std::vector<std::pair<double, double>> windows{{0.9, 1.0}, {0.7, 0.8}, {0.5, 0.6}, {0.3, 0.4}, {0.1, 0.2}};
+  /// Impact numbers k (1 = first impact) grouped for comparison.
+  std::vector<unsigned> impact_numbers{1, 2, 5, 10, 20, 40};
+
+  friend bool operator==(const BounceExperiment&, const BounceExperiment&) = default;
+};
+
+/// Throws std::invalid_argument naming the offending field and value.
+void validate(const BounceExperiment& b);
+
+/// Every impact of every sequence, sequence by sequence, in impact order.
+struct BounceSamples {
+  BounceVariant variant = BounceVariant::dynamic;
+  std::uint64_t sequences = 0;
+  std::vector<std::uint32_t> sequence;  ///< sequence index
+  std::vector<std::uint32_t> number;    ///< impact number k = 1, 2, ...
+  std::vector<double> speed;            ///< impact speed u_k = -V_z before [m/s]
+  std::vector<double> eps;              ///< V'_z / u_k (Eq. 1)
+  std::vector<double> eps_time;         ///< T_k / T_{k-1} from flight times (NaN for k = 1)
+  std::vector<float> spin;              ///< |Omega| before the impact [rad/s]
+  std::vector<float> omega_x_after;     ///< Omega'_x [rad/s]
+  std::vector<std::uint8_t> core;       ///< the central sphere touched (explicit variants)
+  std::uint64_t no_impacts = 0;         ///< sequences cut short: contact point not approaching
+  std::uint64_t cells = 0, centres = 0; ///< lazy-sphere cells and centres generated, summed
+  double seconds = 0;
+};
+
+/// Free rotation of an isotropic body: q(t) = exp(Omega t) q, Omega the constant world-frame
+/// angular velocity [rad/s], t [s] (q maps body to world, orientation.hpp).
+Eigen::Quaterniond advance_rotation(const Eigen::Quaterniond& q, const Vec3& omega, double t);
+
+/// Ballistic flight of the centre from lift-off height h0 [m] with vertical velocity vz > 0 [m/s]
+/// until it is at height D [m]: the later root of h0 + vz t - g t^2/2 = D, and the vertical
+/// velocity then (-sqrt(vz^2 + 2 g (h0 - D)), energy conservation written without cancellation).
+struct Flight {
+  double time = 0;          ///< [s]
+  double landing_vz = 0;    ///< [m/s], <= 0
+};
+Flight ballistic_flight(double h0, double vz, double D, double g);
+
+/// Runs `sequences` sequences of one variant for a sphere (N, R, a). threads = 0: OpenMP default.
+BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b, BounceVariant v, std::uint64_t seed,
+                          int threads = 0);
+
+/// One group of impacts (a speed window or an impact number) and its fit.
+struct BounceGroup {
+  std::string by;              ///< "speed" or "impact"
+  /// What is histogrammed and fitted: "eps" (impact groups: one speed) or "eps-eps_n(u)" (speed
+  /// windows: eps_n changes by ~5e-4 across a 0.1 m/s window, 100x the roughness scatter, so the
+  /// window's law of eps itself would be eps_n's speed dependence, not the fluctuation).
+  std::string quantity;
+  double lo = 0, hi = 0;       ///< window [m/s], or k (lo = hi)
+  std::size_t n = 0;
+  double mean_speed = 0;       ///< [m/s]
+  Estimate eps_mean;           ///< mean of `quantity` with iid se
+  double eps_std = 0;
+  double spin_mean = 0;        ///< mean |Omega| before impact [rad/s]
+  Estimate eps_time_minus_eps; ///< mean of eps(times) - eps(velocities) (impacts k >= 2)
+  bool fitted = false;         ///< n >= 20
+  LaplaceFit fit;
+  LaplaceGof gof;
+  std::vector<double> sorted;  ///< the group's `quantity`, sorted (for figures; not serialised)
+};
+
+struct BounceVariantReport {
+  BounceVariant variant = BounceVariant::dynamic;
+  std::uint64_t sequences = 0, impacts = 0, no_impacts = 0;
+  double impacts_per_sequence = 0;
+  double seconds = 0;
+  double cells_per_sequence = 0, centres_per_sequence = 0;
+  std::vector<BounceGroup> groups;
+  /// eps from flight times against eps from velocities, all impacts k >= 2.
+  std::size_t time_n = 0;
+  double time_diff_mean = 0, time_diff_sd = 0, time_diff_max_abs = 0;
+  double spin_final_mean = 0;   ///< mean |Omega| before the last impact [rad/s]
+  /// Lag-1 correlation of eps - eps_n(u) between consecutive impacts of a sequence (k >= 2), and
+  /// its iid standard error 1/sqrt(pairs): how much the orientation carried between impacts
+  /// correlates consecutive contacts.
+  Estimate lag1_correlation;
+  std::size_t lag1_pairs = 0;
+};
+
+/// Two-sample KS between two variants' groups (same grouping): does the variant change the law?
+struct BounceComparison {
+  BounceVariant a, b;
+  std::string by;
+  double lo = 0, hi = 0;
+  KsResult ks;
+};
+/// For every pair of variants in `r` and every group present in both (n >= 20 each).
+std::vector<BounceComparison> compare_bounce_variants(const std::vector<BounceVariantReport>& r);
+
+/// Groups, fits (profile MLE, Fisher se) and bootstrap goodness of fit (Purpose::analysis streams
+/// keyed by seed). Groups with fewer than 20 impacts are listed without a fit.
+BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperiment& b, std::uint64_t seed);
+
+/// Runs and analyses every variant of `b` in turn (samples are freed after each analysis); writes a
+/// line per variant to `log` if given.
+std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& sphere, const BounceExperiment& b,
+                                                       std::uint64_t seed, int threads = 0, std::ostream* log = nullptr);
+
+/// Why speed windows, not impact numbers, give the unbiased p(eps | u).
+std::string bounce_grouping_note();
+
+
+
+}  // namespace asperity

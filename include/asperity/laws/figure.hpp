@@ -1,0 +1,39 @@
+#pragma once
+// Figures as values: a measured histogram with the analytic laws to overlay. The layers below app/
+// build them; app/plot.hpp renders them (gnuplot), so no experiment writes a file.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "asperity/laws/statistics.hpp"
+
+namespace asperity {
+
+/// An analytic curve to overlay on a histogram.
+struct Curve {
+  std::string label;  ///< legend text, e.g. "Eq. (14), Rayleigh"
+  std::vector<double> x, y;
+};
+
+/// f (e.g. a law's pdf) at segments + 1 equally spaced points on [lo, hi]; where f is not finite
+/// the curve is drawn at 0.
+Curve sampled_curve(const std::function<double(double)>& f, std::string label, double lo, double hi, int segments = 300);
+
+struct HistogramFigure {
+  std::string title;        ///< e.g. "r_{xy}, N = 10^5, fresh, 10^6 drops"
+  std::string xlabel;       ///< with units, e.g. "r_x [µm]"
+  std::string ylabel = "probability density";
+  double x_scale = 1.0;     ///< multiply x values (histogram and curves) for display, e.g. 1e6 for µm
+  double y_scale = 1.0;     ///< multiply densities for display (use 1/x_scale to keep them normalised)
+  Histogram histogram;      ///< drawn as points with Poisson error bars (density, density_se)
+  std::vector<Curve> curves;
+};
+
+/// A figure with the file name it is to be written under (e.g. "r_x.png"), relative to the run's
+/// output directory.
+struct NamedFigure {
+  std::string file;
+  HistogramFigure figure;
+};
+
+}  // namespace asperity

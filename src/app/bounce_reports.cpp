@@ -1,0 +1,354 @@
+// Tables, report.json bodies and gnuplot figures of bounce runs (spheres and mesh bodies).
+#include "asperity/app/experiment_reports.hpp"
+
+#include "asperity/app/report.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <locale>
+#include <sstream>
+
+#include "asperity/app/plot.hpp"
+#include "asperity/core/restitution.hpp"
+#include "core/format.hpp"
+
+namespace asperity {
+
+using detail::fmt;
+using detail::num;
+
+namespace {
+std::string gp_quote(std::string s) {  // inside '...' gnuplot only needs ' doubled
+  for (std::size_t i = s.find('\''); i != std::string::npos; i = s.find('\'', i + 2)) s.insert(i, 1, '\'');
+  return s;
+}
+
+}  // namespace
+
+std::string format_bounce_table(const std::vector<BounceVariantReport>& reports) {
+  std::ostringstream o;
+  o.imbue(std::locale::classic());
+  char line[512];
+  // Rates in units of a power of ten set by the largest left rate: ~1e5 for the rough sphere (the
+  // roughness scatter), ~1e1 for a mesh body (the shape scatter). c can diverge (one-sided law).
+  double a_max = 0;
+  for (const auto& r : reports)
+    for (const auto& g : r.groups)
+      if (g.fitted && std::isfinite(g.fit.a.value)) a_max = std::max(a_max, g.fit.a.value);
+  const int e10 = a_max > 0 ? static_cast<int>(std::floor(std::log10(a_max))) : 5;
+  const double unit = std::pow(10.0, e10);
+  const std::string scale = "[1e" + std::to_string(e10) + "]";
+  std::snprintf(line, sizeof line, "%-18s %-13s %8s %6s %-22s %-24s %-18s %-18s %8s %6s\n", "variant", "group", "n", "<u>",
+                "<eps> +- se", "mode m +- se", ("a +- se " + scale).c_str(), ("c +- se " + scale).c_str(), "KS D", "p");
+  o << line << std::string(150, '-') << "\n";
+  for (const auto& r : reports) {
+    for (const auto& g : r.groups) {
+      const std::string grp = g.by == "speed" ? "u in [" + fmt("%.1f", g.lo) + "," + fmt("%.1f", g.hi) + "]" : "k = " + fmt("%.0f", g.lo);
+      std::string mean = g.n ? fmt(g.by == "speed" ? "%.2e" : "%.7f", g.eps_mean.value) + " +- " + fmt("%.1e", g.eps_mean.se) : "-";
+      std::string m = "-", a = "-", c = "-", D = "-", p = "-";
+      if (g.fitted) {
+        m = fmt(g.by == "speed" ? "%.3e" : "%.8f", g.fit.m.value) + " +- " + fmt("%.1e", g.fit.m.se);
+        a = fmt("%.3f", g.fit.a.value / unit) + " +- " + fmt("%.3f", g.fit.a.se / unit);
+        c = fmt("%.3f", g.fit.c.value / unit) + " +- " + fmt("%.3f", g.fit.c.se / unit);
+        D = fmt("%.4f", g.gof.D), p = fmt("%.2f", g.gof.p);
+      }
+      std::snprintf(line, sizeof line, "%-18s %-13s %8zu %6.3f %-22s %-24s %-18s %-18s %8s %6s\n",
+                    std::string(to_string(r.variant)).c_str(), grp.c_str(), g.n, g.mean_speed, mean.c_str(), m.c_str(),
+                    a.c_str(), c.c_str(), D.c_str(), p.c_str());
+      o << line;
+    }
+    std::snprintf(line, sizeof line,
+                  "%-18s %llu sequences, %.2f impacts each, %.2f s; eps(times) - eps(velocities): mean %.3g, sd %.3g, max |.| %.3g "
+                  "(n = %zu)\n",
+                  std::string(to_string(r.variant)).c_str(), static_cast<unsigned long long>(r.sequences), r.impacts_per_sequence,
+                  r.seconds, r.time_diff_mean, r.time_diff_sd, r.time_diff_max_abs, r.time_n);
+    o << line;
+    std::snprintf(line, sizeof line, "%-18s lag-1 correlation of eps - eps_n(u): %.4f +- %.4f (%zu pairs); <|Omega|> before the last impact %.3f rad/s\n",
+                  std::string(to_string(r.variant)).c_str(), r.lag1_correlation.value, r.lag1_correlation.se, r.lag1_pairs,
+                  r.spin_final_mean);
+    o << line;
+  }
+  o << "a, c: rates of the asymmetric Laplace law (Eq. 2) left/right of the mode [1]; KS p from a parametric bootstrap.\n"
+       "Speed windows fit eps - eps_n(u) (eps_n of Eq. 9 at the impact speed), impact numbers k fit eps itself.\n";
+  return o.str();
+}
+
+std::string bounce_to_json(const std::string& scene_name, const SphereParams& sphere, const BounceExperiment& b,
+                           std::uint64_t seed, const std::vector<BounceVariantReport>& reports,
+                           const std::vector<std::string>& plots, const std::vector<BounceComparison>& comparisons) {
+  using nlohmann::json;
+  auto jnum = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
+  json j;
+  j["schema_version"] = 1;
+  j["tool"] = "validate-geometry";
+  j["scene"] = scene_name;
+  j["mode"] = "bounce";
+  std::uint64_t impacts = 0;
+  for (const auto& r : reports) impacts += r.impacts;
+  j["samples"] = impacts;
+  j["parameters"] = {{"asperities", sphere.asperities}, {"radius_m", sphere.radius}, {"asperity_radius_m", sphere.asperity_radius},
+                     {"seed", seed}};
+  j["rejected"] = false;
+  j["plots"] = plots;
+  json variants = json::array();
+  for (const auto& r : reports) {
+    json v;
+    v["name"] = std::string(to_string(r.variant));
+    v["sequences"] = r.sequences, v["impacts"] = r.impacts, v["impacts_per_sequence"] = r.impacts_per_sequence;
+    v["no_impacts"] = r.no_impacts, v["seconds"] = r.seconds;
+    v["sequences_per_second"] = jnum(static_cast<double>(r.sequences) / r.seconds);
+    v["lazy_cells_per_sequence"] = r.cells_per_sequence, v["lazy_centres_per_sequence"] = r.centres_per_sequence;
+    v["spin_before_last_impact_mean_rad_s"] = r.spin_final_mean;
+    v["lag1_correlation"] = {{"value", jnum(r.lag1_correlation.value)}, {"se", jnum(r.lag1_correlation.se)}, {"pairs", r.lag1_pairs},
+                             {"quantity", "eps-eps_n(u)"}};
+    v["eps_time_vs_velocity"] = {{"n", r.time_n}, {"mean", jnum(r.time_diff_mean)}, {"sd", jnum(r.time_diff_sd)},
+                                 {"max_abs", jnum(r.time_diff_max_abs)}};
+    json groups = json::array();
+    for (const auto& g : r.groups) {
+      json x;
+      x["by"] = g.by;
+      x["range"] = {g.lo, g.hi};
+      x["n"] = g.n;
+      x["quantity"] = g.quantity;
+      x["mean_speed_m_s"] = jnum(g.mean_speed);
+      x["eps_mean"] = jnum(g.eps_mean.value), x["eps_mean_se"] = jnum(g.eps_mean.se), x["eps_std"] = jnum(g.eps_std);
+      x["spin_mean_rad_s"] = jnum(g.spin_mean);
+      x["eps_time_minus_eps"] = {{"mean", jnum(g.eps_time_minus_eps.value)}, {"se", jnum(g.eps_time_minus_eps.se)}};
+      if (g.fitted) {
+        const auto& f = g.fit;
+        x["fit"] = {{"law", "asymmetric-laplace"}, {"m", f.m.value}, {"m_se", jnum(f.m.se)}, {"log_a", f.log_a.value},
+                    {"log_a_se", jnum(f.log_a.se)}, {"log_c", f.log_c.value}, {"log_c_se", jnum(f.log_c.se)},
+                    {"a", f.a.value}, {"a_se", jnum(f.a.se)}, {"c", f.c.value}, {"c_se", jnum(f.c.se)},
+                    {"log_likelihood", f.log_likelihood}, {"se_method", "Fisher information"}};
+        x["ks"] = {{"statistic", "KS"}, {"D", g.gof.D}, {"p", jnum(g.gof.p)}, {"bootstrap", g.gof.bootstrap},
+                   {"p_method", "parametric bootstrap (parameters refitted)"}, {"decisive", false}};
+      } else {
+        x["fit"] = nullptr, x["ks"] = nullptr;
+      }
+      groups.push_back(std::move(x));
+    }
+    v["groups"] = std::move(groups);
+    variants.push_back(std::move(v));
+  }
+  json cmp = json::array();
+  for (const auto& c : comparisons)
+    cmp.push_back({{"a", std::string(to_string(c.a))}, {"b", std::string(to_string(c.b))}, {"by", c.by}, {"range", {c.lo, c.hi}},
+                   {"statistic", "KS two-sample"}, {"D", c.ks.D}, {"p", jnum(c.ks.p)}, {"n_eff", c.ks.n}});
+  j["bounce"] = {{"variants", variants},
+                 {"variant_comparisons", cmp},
+                 {"grouping_note", bounce_grouping_note()},
+                 {"first_speed_m_s", b.speed},
+                 {"stop_speed_m_s", b.stop_speed},
+                 {"gravity_m_s2", b.gravity},
+                 {"density_kg_m3", b.density},
+                 {"beta", b.beta},
+                 {"eps_t", b.eps_t},
+                 {"bootstrap", b.bootstrap},
+                 {"eps_time_note", "eps(times) = T_k / T_(k-1) from the flight times before and after impact k; it differs "
+                                   "from eps = V'_z/V_z by the height differences of successive lowest points"}};
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::string> write_bounce_plots(const std::filesystem::path& dir, const std::vector<BounceVariantReport>& reports) {
+  std::vector<std::string> files;
+  for (const auto& r : reports) {
+    std::vector<const BounceGroup*> gs;
+    for (const auto& g : r.groups)
+      if (g.by == "speed" && g.fitted) gs.push_back(&g);
+    if (gs.empty()) continue;
+    const std::string name = "fig6_" + std::string(to_string(r.variant)) + ".png";
+    auto script = [&](const std::filesystem::path& out) {
+      std::ostringstream s;
+      s.imbue(std::locale::classic());
+      s.precision(10);
+      static const char* colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"};
+      double ymin = 1e300, ymax = 0, xlo = 1e300, xhi = -1e300;
+      for (std::size_t k = 0; k < gs.size(); ++k) {
+        const auto& g = *gs[k];
+        const auto& f = g.fit.law;
+        // eps - m in units of 1e-6, range from the 0.1% and 99.9% sample quantiles.
+        const double lo = (quantile_sorted(g.sorted, 0.001) - f.m) * 1e6, hi = (quantile_sorted(g.sorted, 0.999) - f.m) * 1e6;
+        std::vector<double> x(g.sorted.size());
+        for (std::size_t i = 0; i < x.size(); ++i) x[i] = (g.sorted[i] - f.m) * 1e6;
+        const auto h = make_histogram(x, lo, hi, 60);
+        s << "$h" << k << " << EOD\n";
+        for (std::size_t i = 0; i < h.bins(); ++i)
+          if (h.counts[i] > 0) {
+            s << h.centre(i) << ' ' << h.density(i) << ' ' << h.density_se(i) << '\n';
+            ymin = std::min(ymin, h.density(i)), ymax = std::max(ymax, h.density(i));
+          }
+        s << "EOD\n$f" << k << " << EOD\n";
+        for (int i = 0; i <= 400; ++i) {
+          const double t = lo + (hi - lo) * i / 400.0;
+          s << t << ' ' << f.pdf(f.m + t * 1e-6) * 1e-6 << '\n';
+        }
+        s << "EOD\n";
+        xlo = std::min(xlo, lo), xhi = std::max(xhi, hi);
+      }
+      s << "set encoding utf8\nset terminal pngcairo size 900,650 enhanced font 'sans,12'\nset output '" << gp_quote(out.string()) << "'\n"
+        << "set logscale y\nset format y '10^{%L}'\nset xrange [" << xlo << ":" << xhi << "]\nset yrange [" << ymin / 3 << ":"
+        << ymax * 3 << "]\n"
+        << "set xlabel '{/Symbol e} - {/Symbol e}_n(u) - m [10^{-6}]'\nset ylabel 'probability density [1/10^{-6}]'\n"
+        << "set key top left\nset title 'Fig. 6, " << to_string(r.variant) << ": impact-speed windows, fitted asymmetric Laplace (Eq. 2)'\n"
+        << "plot ";
+      for (std::size_t k = 0; k < gs.size(); ++k) {
+        const auto& g = *gs[k];
+        const char* col = colours[k % 6];
+        s << (k ? ", \\\n  " : "") << "$h" << k << " using 1:2:3 with yerrorbars pointtype 7 pointsize 0.5 lc rgb '" << col
+          << "' title 'u in [" << g.lo << "," << g.hi << "] m/s (n = " << g.n << ")', $f" << k
+          << " using 1:2 with lines lw 2 lc rgb '" << col << "' notitle";
+      }
+      s << "\nunset output\n";
+      return s.str();
+    };
+    write_gnuplot_png(dir / name, script);
+    files.push_back(name);
+  }
+  return files;
+}
+
+namespace {
+
+// eps against impact speed: mean +- se and the 10/90% quantiles per speed bin, eps_n(u) of Eq. 9
+// (what a smooth sphere would give) for reference.
+void plot_eps_vs_speed(const std::filesystem::path& png, const BodyBounceReport& r, const BounceExperiment& b,
+                       const std::string& title) {
+  const auto en = viscoelastic_pade14(b.beta);
+  write_gnuplot_png(png, [&](const std::filesystem::path& out) {
+    std::ostringstream o;
+    o.imbue(std::locale::classic());
+    o.precision(10);
+    o << "$m << EOD\n";
+    for (const auto& x : r.by_speed)
+      if (x.n >= 5)
+        o << 0.5 * (x.lo + x.hi) << ' ' << x.eps.value << ' ' << x.eps.se << ' ' << x.eps_q10 << ' ' << x.eps_q90 << '\n';
+    o << "EOD\n$n << EOD\n";
+    for (int i = 0; i <= 100; ++i) {
+      const double u = b.stop_speed + (b.speed - b.stop_speed) * i / 100.0;
+      o << u << ' ' << (*en)(u) << '\n';
+    }
+    o << "EOD\nset encoding utf8\nset terminal pngcairo size 900,600 enhanced font 'sans,12'\nset output '" << out.string()
+      << "'\nset title '" << title << "'\nset xlabel 'impact speed u = -V_z [m/s]'\nset ylabel '{/Symbol e} = -V''_z/V_z'\n"
+      << "set key bottom right\nset grid\nset yrange [-0.5:3]\n"
+      << "plot $m using 1:4:5 with filledcurves lc rgb '#cce0f0' title '10%-90% of impacts', \\\n"
+      << "  $m using 1:2:3 with yerrorbars pt 7 ps 0.8 lc rgb '#0072B2' title 'mean {/Symbol \\261} se', \\\n"
+      << "  $n using 1:2 with lines lw 2 lc rgb '#D55E00' title '{/Symbol e}_n(u), Eq. (9): smooth sphere'\nunset output\n";
+    return o.str();
+  });
+}
+
+}  // namespace
+
+std::string format_table(const MeshBounceReport& r) {
+  const auto& e = r.experiment;
+  const auto& b = r.report;
+  const auto& st = b.stops;
+  std::ostringstream os;
+  os.imbue(std::locale::classic());
+  os << std::setprecision(4);
+  os << "bounce sequences of a rough body: " << r.body_name
+     << (e.mesh.empty() ? "" : e.smooth.empty() ? " (centres on the facets)" : " (centres on the smooth surface)") << ", N = "
+     << e.asperities << ", radii " << e.radii.describe() << ", " << e.bodies << " bodies\n";
+  os << "mass " << r.mass << " kg, principal moments " << r.principal_moments.transpose() << " kg m^2, max |c_i| " << r.c_max
+     << " m\n";
+  os << "first impact u = " << e.options.bounce.speed << " m/s, Omega = " << e.options.bounce.omega.transpose() << " rad/s, stop below "
+     << e.options.bounce.stop_speed << " m/s, g = " << e.options.bounce.gravity << " m/s^2\n";
+  os << b.base.sequences << " sequences, " << b.base.impacts << " impacts: " << b.base.impacts_per_sequence << " +- "
+     << b.impacts_per_sequence_sd << " (sd) per sequence, max " << b.impacts_max << "\n";
+ os << "stops: slow " << st.slow << ", no approach " << st.no_approach
+     << ", max impacts " << st.max_impacts << ", max time " << st.max_time << ", max steps " << st.max_steps << "\n";
+  os << "impacts with the centre rising (u <= 0: rocking onto another asperity): " << b.rising_fraction << "\n";
+  os << "eps < 0: " << b.eps_below_0 << ", eps > 1: " << b.eps_above_1 << " (fractions of impacts); <|Omega|> before the last impact "
+     << b.base.spin_final_mean << " rad/s; rotational share of the kinetic energy after the last impact " << b.rot_fraction_last
+     << "\n";
+  os << "energy: impacts gaining energy " << b.energy_gain_fraction << " (max gain " << b.energy_gain_max
+     << " of E), work identity max rel. residual " << b.work_identity_max << ", flight energy max rel. drift " << b.flight_energy_max
+     << "\n";
+  os << "landing search: " << b.queries_per_flight << " support queries per flight, flights < 1 ms: " << b.short_flights << "\n";
+  os << "run " << r.seconds_run << " s (" << static_cast<double>(b.base.sequences) / r.seconds_run << " sequences/s), bodies "
+     << r.seconds_build << " s, support trees " << r.seconds_index << " s, analysis " << r.seconds_analysis << " s, figures "
+     << r.seconds_plots << " s\n\n";
+  os << "u bin [m/s]        n   <eps> +- se          eps 10% .. 90%     <|Omega|> [rad/s]\n";
+  for (const auto& x : b.by_speed) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%.3f-%.3f %7zu   %8.4f +- %-8.4f  %7.3f .. %-7.3f  %8.2f\n", x.lo, x.hi, x.n, x.eps.value,
+                  x.eps.se, x.eps_q10, x.eps_q90, x.spin_mean);
+    os << line;
+  }
+  os << "\n";
+  os << format_bounce_table({b.base});
+  return os.str();
+}
+
+std::string to_json(const MeshBounceReport& r) {
+  const auto& e = r.experiment;
+  const auto& b = r.report;
+  auto jnum = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  // The fig6 report of the same groups and fits (bounce.hpp), with the body in place of the sphere.
+  SphereParams none;
+  none.asperities = e.asperities;
+  nlohmann::json j = nlohmann::json::parse(bounce_to_json("", none, e.options.bounce, e.seed, {b.base}, r.plots));
+  j.erase("scene");  // the header's (with_header, report.hpp)
+  j["mode"] = "body-bounce";
+  j["parameters"] = {{"asperities", e.asperities}, {"radii", e.radii.describe()}, {"bodies", e.bodies}, {"seed", e.seed}};
+  j["body"] = {{"name", r.body_name},
+               {"mesh", e.mesh.string()},
+               {"scale", e.scale},
+               {"smooth", e.smooth},
+               {"sphere_radius_m", e.mesh.empty() ? jnum(e.sphere_radius) : nlohmann::json(nullptr)},
+               {"mass_kg", r.mass},
+               {"density_kg_m3", e.density},
+               {"principal_moments_kg_m2", {r.principal_moments.x(), r.principal_moments.y(), r.principal_moments.z()}},
+               {"c_max_m", r.c_max}};
+  nlohmann::json bins = nlohmann::json::array();
+  for (const auto& x : b.by_speed)
+    bins.push_back({{"range", {x.lo, x.hi}}, {"n", x.n}, {"eps_mean", jnum(x.eps.value)}, {"eps_mean_se", jnum(x.eps.se)},
+                    {"eps_q10", jnum(x.eps_q10)}, {"eps_q90", jnum(x.eps_q90)}, {"spin_mean_rad_s", jnum(x.spin_mean)}});
+  const auto& st = b.stops;
+  const Vec3& w0 = e.options.bounce.omega;
+  j["bounce"]["omega_rad_s"] = {w0.x(), w0.y(), w0.z()};
+  j["bounce"]["max_time_s"] = e.options.max_time;
+  j["bounce"]["max_impacts"] = e.options.bounce.max_impacts;
+  j["bounce"]["time_tolerance_s"] = e.options.landing.time_tolerance;
+  j["bounce"]["stop_rule"] =
+      "before each impact: total time > max_time; no approach of the lowest asperity; its normal approach speed "
+      "-v_n < stop_speed ('slow'); after impact max_impacts; a landing search > max_steps";
+  j["bounce"]["body"] = {{"stops", {{"slow", st.slow}, {"no_approach", st.no_approach},
+                                    {"max_impacts", st.max_impacts}, {"max_time", st.max_time}, {"max_steps", st.max_steps}}},
+                         {"impacts_per_sequence_sd", b.impacts_per_sequence_sd},
+                         {"impacts_max", b.impacts_max},
+                         {"support_queries_per_flight", jnum(b.queries_per_flight)},
+                         {"rising_fraction", jnum(b.rising_fraction)},
+                         {"eps_below_0_fraction", jnum(b.eps_below_0)},
+                         {"eps_above_1_fraction", jnum(b.eps_above_1)},
+                         {"rotational_share_after_last", jnum(b.rot_fraction_last)},
+                         {"energy_gain_fraction", jnum(b.energy_gain_fraction)},
+                         {"energy_gain_max_rel", jnum(b.energy_gain_max)},
+                         {"work_identity_max_rel", b.work_identity_max},
+                         {"flight_energy_max_rel", b.flight_energy_max},
+                         {"short_flight_fraction", jnum(b.short_flights)},
+                         {"eps_by_speed", bins},
+                         {"seconds_build", r.seconds_build},
+                         {"seconds_index", r.seconds_index},
+                         {"seconds_run", r.seconds_run},
+                         {"sequences_per_second", jnum(static_cast<double>(b.base.sequences) / r.seconds_run)},
+                         {"seconds_analysis", r.seconds_analysis},
+                         {"seconds_plots", r.seconds_plots}};
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::string> write_mesh_bounce_plots(const std::filesystem::path& dir, const MeshBounceReport& r) {
+  std::vector<std::string> plots;
+  plot_eps_vs_speed(dir / "eps_vs_speed.png", r.report, r.experiment.options.bounce,
+                    "{/Symbol e} against impact speed: " + mesh_bounce_subtitle(r));
+  plots.push_back("eps_vs_speed.png");
+  for (const auto& f : write_figures(dir, r.figures)) plots.push_back(f);
+  for (const auto& f : write_bounce_plots(dir, {r.report.base})) plots.push_back(f);
+  return plots;
+}
+
+}  // namespace asperity

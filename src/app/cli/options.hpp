@@ -1,0 +1,32 @@
+#pragma once
+// The command line of validate-geometry, parsed into a validated Scene without touching the file
+// system: main() and the fuzz target (tests/fuzz/cli_options.cpp) call the same function.
+#include <functional>
+#include <span>
+#include <stdexcept>
+#include <string>
+
+#include "asperity/app/scene.hpp"
+
+namespace asperity::cli {
+
+/// Bad user input. what() names the option and the offending value; validate-geometry exits 2.
+struct BadInput : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct Options {
+  Scene scene;             ///< validated (asperity::validate) unless `help`
+  bool quiet = false;      ///< --quiet: no progress lines
+  bool help = false;       ///< --help was given: print help_text, exit 0, nothing else
+  std::string help_text;
+};
+
+/// Parses the arguments after the program name. Throws BadInput (and only BadInput) for any bad
+/// option or value: unknown options, malformed/non-finite/out-of-range numbers, scenes that fail
+/// validate(). No files are written; `--scene FILE` is read through `load` (load_scene by default;
+/// the fuzz target passes its own, so that fuzzing never touches the file system).
+using SceneLoader = std::function<Scene(const std::string& file)>;
+Options parse_command_line(std::span<const std::string> args, const SceneLoader& load = {});
+
+}  // namespace asperity::cli

@@ -1,0 +1,353 @@
+// Histogram-vs-theory figures drawn by gnuplot (pngcairo). The script and its inline data go to a
+// private temporary directory, gnuplot renders to a temporary file beside the target, and the
+// result is renamed onto the target only when gnuplot succeeded: a failure never leaves a partial
+// PNG, and temporaries are always removed.
+#include "asperity/app/plot.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <locale>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace asperity {
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Quote for a POSIX shell: '...' with embedded ' written as '\''.
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) {
+    if (c == '\'') out += "'\\''";
+    else out += c;
+  }
+  out += '\'';
+  return out;
+}
+
+/// A gnuplot single-quoted string (no backslash processing; ' is doubled). Used for paths.
+std::string gp_path(const fs::path& p) {
+  std::string out = "'";
+  for (char c : p.string()) {
+    if (c == '\'') out += "''";
+    else out += c;
+  }
+  out += '\'';
+  return out;
+}
+
+/// A gnuplot double-quoted string for labels (enhanced text is kept: r_{xy}, 10^{6}).
+/// Backslashes and double quotes are escaped; control characters become spaces.
+std::string gp_text(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (c == '\n' || c == '\r' || c == '\t') {
+      out += ' ';
+    } else {
+      out += c;
+    }
+  }
+  out += '"';
+  return out;
+}
+
+/// Runs a shell command; true when it exited normally with status 0.
+bool run_ok(const std::string& cmd) {
+  const int rc = std::system(cmd.c_str());
+  return rc != -1 && WIFEXITED(rc) && WEXITSTATUS(rc) == 0;
+}
+
+std::string random_suffix() {
+  std::random_device rd;
+  std::ostringstream s;
+  s << ::getpid() << '-' << std::hex << rd() << rd();
+  return s.str();
+}
+
+std::string read_file_text(const fs::path& p, std::size_t max_chars = 4000) {
+  std::ifstream in(p, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (text.size() > max_chars) text = text.substr(0, max_chars) + "...";
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  return text;
+}
+
+/// Removes its paths (recursively) when it goes out of scope, ignoring errors.
+struct Cleanup {
+  std::vector<fs::path> paths;
+  ~Cleanup() {
+    for (const auto& p : paths) {
+      std::error_code ec;
+      fs::remove_all(p, ec);
+    }
+  }
+};
+
+/// Sample count for the legend: exact powers of ten >= 1000 as enhanced-text "10^{5}", anything
+/// else as the plain integer (never rounded: the legend states the exact n).
+std::string format_count(std::size_t n) {
+  if (n >= 1000) {
+    std::size_t k = n;
+    int e = 0;
+    while (k % 10 == 0) {
+      k /= 10;
+      ++e;
+    }
+    if (k == 1) return "10^{" + std::to_string(e) + "}";
+  }
+  return std::to_string(n);
+}
+
+void validate(const HistogramFigure& fig) {
+  const Histogram& h = fig.histogram;
+  if (h.bins() == 0) throw std::invalid_argument("write_histogram_png: histogram has no bins");
+  if (h.total == 0) throw std::invalid_argument("write_histogram_png: histogram is empty (total = 0)");
+  if (!std::isfinite(h.lo) || !std::isfinite(h.hi) || !(h.hi > h.lo))
+    throw std::invalid_argument("write_histogram_png: histogram range [lo, hi) is not finite and increasing");
+  double sum = 0;
+  for (std::size_t i = 0; i < h.bins(); ++i) {
+    if (!std::isfinite(h.counts[i]) || h.counts[i] < 0)
+      throw std::invalid_argument("write_histogram_png: histogram count in bin " + std::to_string(i) +
+                                  " is negative or not finite");
+    sum += h.counts[i];
+  }
+  if (!(sum > 0)) throw std::invalid_argument("write_histogram_png: histogram has no counts in [lo, hi)");
+  if (!std::isfinite(fig.x_scale) || fig.x_scale == 0)
+    throw std::invalid_argument("write_histogram_png: x_scale is zero or not finite");
+  if (!std::isfinite(fig.y_scale) || !(fig.y_scale > 0))
+    throw std::invalid_argument("write_histogram_png: y_scale is not positive and finite");
+  for (const auto& c : fig.curves) {
+    if (c.x.size() != c.y.size())
+      throw std::invalid_argument("write_histogram_png: curve \"" + c.label + "\" has x and y of different lengths");
+    if (c.x.size() < 2)
+      throw std::invalid_argument("write_histogram_png: curve \"" + c.label + "\" has fewer than 2 points");
+    for (std::size_t i = 0; i < c.x.size(); ++i)
+      if (!std::isfinite(c.x[i]) || !std::isfinite(c.y[i]))
+        throw std::invalid_argument("write_histogram_png: curve \"" + c.label + "\" has a non-finite value at point " +
+                                    std::to_string(i));
+  }
+}
+
+struct Style {
+  const char* colour;
+  const char* dash;  // gnuplot dashtype
+};
+// Colour-blind-safe (Okabe-Ito) line colours; the first curve solid, then dashed, dash-dotted...
+constexpr Style kCurveStyles[] = {
+    {"#D55E00", "solid"}, {"#0072B2", "(14,8)"}, {"#009E73", "(18,7,3,7)"},
+    {"#CC79A7", "(3,6)"}, {"#E69F00", "(8,8)"}, {"#56B4E9", "(24,8)"},
+};
+
+std::string build_script(const HistogramFigure& fig, const fs::path& out) {
+  const Histogram& h = fig.histogram;
+  const double xs = fig.x_scale, ys = fig.y_scale;
+
+  std::ostringstream s;
+  s.imbue(std::locale::classic());
+  s << std::setprecision(17);
+
+  // ---- data ----
+  double ymax = 0, ymin_pos = std::numeric_limits<double>::infinity();
+  s << "$hist << EOD\n";
+  for (std::size_t i = 0; i < h.bins(); ++i) {
+    const double d = h.density(i) * ys, e = h.density_se(i) * ys;
+    if (!std::isfinite(d) || !std::isfinite(e))
+      throw std::invalid_argument("write_histogram_png: density in bin " + std::to_string(i) + " is not finite");
+    s << h.centre(i) * xs << ' ' << d << ' ' << e << ' ' << h.counts[i] << '\n';
+    ymax = std::max(ymax, d + e);
+    if (h.counts[i] > 0) ymin_pos = std::min(ymin_pos, d);
+  }
+  s << "EOD\n";
+  double xa = h.lo * xs, xb = h.hi * xs;
+  if (xa > xb) std::swap(xa, xb);
+  double curve_max = 0;
+  for (std::size_t k = 0; k < fig.curves.size(); ++k) {
+    const Curve& c = fig.curves[k];
+    s << "$curve" << k << " << EOD\n";
+    for (std::size_t i = 0; i < c.x.size(); ++i) {
+      const double x = c.x[i] * xs, y = c.y[i] * ys;
+      if (!std::isfinite(x) || !std::isfinite(y))
+        throw std::invalid_argument("write_histogram_png: scaled curve \"" + c.label + "\" is not finite");
+      s << x << ' ' << y << '\n';
+      if (x >= xa && x <= xb) curve_max = std::max(curve_max, y);
+    }
+    s << "EOD\n";
+  }
+
+  // ---- common style ----
+  s << "set encoding utf8\n"
+    << "set terminal pngcairo size 900,1000 enhanced font 'sans,12' linewidth 1.2 rounded\n"
+    << "set output " << gp_path(out) << "\n"
+    << "set border 31 linewidth 1.0\n"
+    << "set minussign\n"
+    << "set pointintervalbox 0.01\n"  // no white halo around points with error bars (0 = default)
+    << "set errorbars 0.7\n"
+    << "set xtics in mirror scale 1.2,0.6\n"
+    << "set ytics in mirror scale 1.2,0.6\n"
+    << "unset x2tics\nunset y2tics\n"
+    << "set mxtics\n"
+    << "set xrange [" << xa << ":" << xb << "]\n"
+    << "set xlabel " << gp_text(fig.xlabel) << "\n"
+    << "set ylabel " << gp_text(fig.ylabel) << " offset 0.5,0\n"
+    << "set key top right reverse Left samplen 3.5 spacing 1.25 width 1 nobox\n"
+    << "set style line 100 linecolor rgb '#E2E2E2' linewidth 0.8 dashtype solid\n"
+    << "set lmargin 12\nset rmargin 4\n"
+    << "set multiplot layout 2,1 title " << gp_text(fig.title) << " font 'sans,14'\n";
+
+  // Legend entry for the data first, then the curves, then the data drawn on top without a title.
+  const std::string data_title =
+      "explicit geometry (n = " + format_count(h.total) + ")";
+  auto plot_cmd = [&](bool log_panel) {
+    s << "plot NaN with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 title "
+      << gp_text(data_title);
+    for (std::size_t k = 0; k < fig.curves.size(); ++k) {
+      const Style& st = kCurveStyles[k % std::size(kCurveStyles)];
+      s << ", \\\n     $curve" << k << " using 1:"
+        << (log_panel ? "($2 > 0 ? $2 : NaN)" : "2")
+        << " with lines linewidth 2.2 linecolor rgb '" << st.colour << "' dashtype " << st.dash << " title "
+        << gp_text(fig.curves[k].label);
+    }
+    s << ", \\\n     $hist using 1:"
+      << (log_panel ? "($4 > 0 ? $2 : NaN):($2 - $3 > LOGFLOOR ? $2 - $3 : LOGFLOOR):($2 + $3)" : "2:3")
+      << " with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 notitle\n";
+  };
+
+  // The data set the ranges; a curve may raise them by at most a factor 2 (a divergent or badly
+  // wrong curve must not squash the measurement).
+  curve_max = std::min(curve_max, 2.0 * ymax);
+
+  // ---- top: linear ----
+  // The legend sits in the top panel above everything plotted: leave headroom for its rows
+  // (~21 px each at 12 pt, in a plot area ~400 px high).
+  const double key_rows = 1.0 + static_cast<double>(fig.curves.size());
+  const double key_frac = std::min(0.5, (21.0 * key_rows + 24.0) / 400.0);
+  const double ytop = std::max(ymax, curve_max) / (1.0 - key_frac);
+  s << "set yrange [0:" << ytop << "]\n"
+    << "set mytics\n"
+    << "set format y '%g'\n"
+    << "set grid noxtics noytics\n";
+  plot_cmd(false);
+
+  // ---- bottom: logarithmic ----
+  // Lower bound: the decade at or below a third of the smallest non-zero density, so the lowest
+  // point (a single count) sits clearly above the axis. The legend is not repeated here.
+  const double lo_decade = std::pow(10.0, std::floor(std::log10(ymin_pos / 3.0)));
+  const double hi_decade = std::max(std::pow(10.0, std::ceil(std::log10(std::max(ymax, curve_max) * 1.5))),
+                                    100.0 * lo_decade);  // at least two labelled decades
+  s << "LOGFLOOR = " << lo_decade / 10.0 << "\n"
+    << "set logscale y 10\n"
+    << "set yrange [" << lo_decade << ":" << hi_decade << "]\n"
+    << "set format y '10^{%L}'\n"
+    << "set mytics 10\n"
+    << "unset key\n"
+    << "set grid ytics linestyle 100\n";
+  plot_cmd(true);
+
+  s << "unset multiplot\n"
+    << "unset output\n";
+  return s.str();
+}
+
+}  // namespace
+
+
+bool plotting_available() {
+  return run_ok("gnuplot -e \"set terminal pngcairo\" >/dev/null 2>&1 </dev/null");
+}
+
+namespace {
+
+// Renders the script `script_for(out)` with gnuplot into `png`: script and gnuplot's stderr in a
+// private temporary directory, the image beside the target, renamed onto it only on success.
+// `who` prefixes every message.
+void run_gnuplot(const char* who, const fs::path& png, const std::function<std::string(const fs::path& out)>& script_for) {
+  const std::string w = who;
+  if (png.empty()) throw std::invalid_argument(w + ": empty output path");
+  if (!png.has_filename()) throw std::invalid_argument(w + ": output path has no file name");
+  const std::string suffix = random_suffix();
+  Cleanup cleanup;
+
+  // Private work directory for script and gnuplot's stderr.
+  std::error_code ec;
+  const fs::path tmp_root = fs::temp_directory_path(ec);
+  if (ec) throw std::runtime_error(w + ": no temporary directory: " + ec.message());
+  std::string stem = png.stem().string();
+  for (char& c : stem)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  if (stem.size() > 64) stem.resize(64);
+  const fs::path work = tmp_root / ("asperity-plot-" + stem + "-" + suffix);
+  if (!fs::create_directory(work, ec) || ec)
+    throw std::runtime_error(w + ": cannot create " + work.string() +
+                             (ec ? ": " + ec.message() : std::string(": already exists")));
+  cleanup.paths.push_back(work);
+
+  // Gnuplot renders beside the target so the final rename is atomic (same filesystem).
+  const fs::path out = png.parent_path() / (png.filename().string() + "." + suffix + ".tmp");
+  cleanup.paths.push_back(out);
+
+  const fs::path script = work / "figure.gp";
+  const fs::path err = work / "gnuplot.err";
+  {
+    const std::string text = script_for(out);
+    std::ofstream f(script, std::ios::binary);
+    f << text;
+    f.close();
+    if (!f) throw std::runtime_error(w + ": cannot write " + script.string());
+  }
+
+  const std::string cmd =
+      "gnuplot " + shell_quote(script.string()) + " </dev/null >/dev/null 2>" + shell_quote(err.string());
+  const bool ok = run_ok(cmd);
+  const std::string messages = read_file_text(err);
+  if (!ok)
+    throw std::runtime_error(w + ": gnuplot failed writing " + png.string() +
+                             (messages.empty() ? std::string(" (no message; is gnuplot installed?)")
+                                               : ":\n" + messages));
+  if (!fs::is_regular_file(out, ec) || fs::file_size(out, ec) == 0 || ec)
+    throw std::runtime_error(w + ": gnuplot produced no output for " + png.string() +
+                             (messages.empty() ? std::string() : ":\n" + messages));
+
+  fs::rename(out, png, ec);
+  if (ec) throw std::runtime_error(w + ": cannot rename onto " + png.string() + ": " + ec.message());
+}
+
+}  // namespace
+
+void write_histogram_png(const fs::path& png, const HistogramFigure& fig) {
+  if (png.empty()) throw std::invalid_argument("write_histogram_png: empty output path");
+  if (!png.has_filename()) throw std::invalid_argument("write_histogram_png: output path has no file name");
+  validate(fig);
+  run_gnuplot("write_histogram_png", png, [&](const fs::path& out) { return build_script(fig, out); });
+}
+
+void write_gnuplot_png(const fs::path& png, const std::function<std::string(const fs::path& out)>& script_for) {
+  run_gnuplot("write_gnuplot_png", png, script_for);
+}
+
+std::vector<std::string> write_figures(const fs::path& dir, const std::vector<NamedFigure>& figures) {
+  std::vector<std::string> names;
+  for (const auto& f : figures) {
+    write_histogram_png(dir / f.file, f.figure);
+    names.push_back(f.file);
+  }
+  return names;
+}
+
+}  // namespace asperity

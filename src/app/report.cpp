@@ -1,0 +1,566 @@
+#include "asperity/app/report.hpp"
+
+#include "asperity/app/atomic_file.hpp"
+
+#include <boost/math/distributions/binomial.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <unistd.h>
+
+#include "asperity/app/plot.hpp"
+#include "asperity/core/random.hpp"
+#include "asperity/laws/theory.hpp"
+#include "asperity/laws/theory_impact.hpp"
+
+namespace asperity {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+const std::vector<double> kProbs{0.01, 0.05, 0.25, 0.5, 0.75, 0.95, 0.99};
+// Mean of the asymptotic Kolmogorov distribution of sqrt(n) D: sqrt(pi/2) ln 2.
+constexpr double kKsMean = 0.8687;
+
+std::vector<double> sorted(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+// KS of x against a law with an atom of mass m at `atom`, taken by the samples flagged in `at_atom`:
+// u_i = F(x_i) elsewhere, u_i = F(atom) - m + V_i m there (V_i uniform from a counter-based
+// stream), and the u_i are tested against the uniform law. Without atom samples this is the plain
+// KS test. Parallel over samples; the result does not depend on the thread count.
+KsResult ks_mixed(const std::vector<double>& x, const std::vector<std::uint8_t>& at_atom, const Law& law, double atom,
+                  double mass, std::uint64_t seed) {
+  std::vector<double> u(x.size());
+  const double below = law.cdf(atom) - mass;
+  const std::int64_t n = static_cast<std::int64_t>(x.size());
+  // law.cdf may throw far outside a law's regime; an exception must not leave the OpenMP region.
+  std::exception_ptr error;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < n; ++i) try {
+    const auto k = static_cast<std::size_t>(i);
+    if (!at_atom.empty() && at_atom[k]) {
+      Stream st(seed, Purpose::analysis, k);
+      u[k] = below + st.uniform0() * mass;
+    } else {
+      u[k] = law.cdf(x[k]);
+    }
+  } catch (...) {
+#pragma omp critical(asperity_ks_mixed_error)
+    if (!error) error = std::current_exception();
+  }
+  if (error) std::rethrow_exception(error);
+  std::sort(u.begin(), u.end());
+  return ks_one_sample(u, [](double t) { return std::clamp(t, 0.0, 1.0); });
+}
+
+struct LawSet {
+  std::string quantity;
+  std::vector<Law> laws;
+  std::vector<bool> decisive;  // printed laws with known errors are reported, not decisive
+  // Corrected impact laws include core contacts as an atom of mass p_core at `atom`; their KS
+  // test uses the randomised probability integral transform there (exact for mixed laws).
+  std::vector<bool> has_atom = {};
+  double atom = 0, atom_mass = 0;
+};
+
+ImpactScene impact_scene(const EnsembleConfig& e) {
+  ImpactScene x;
+  x.asperities = e.sphere.asperities;
+  x.radius = e.sphere.radius;
+  x.asperity_radius = e.sphere.asperity_radius;
+  x.speed = e.impact.speed;
+  x.omega_x = e.impact.omega.x();
+  x.omega_y = e.impact.omega.y();
+  x.beta = e.impact.beta;
+  return x;
+}
+
+// A law the run should have tested but could not: reported with verdict "skipped".
+struct SkippedLaw {
+  std::string quantity, law;
+  bool decisive = false;
+  std::string reason;
+};
+
+// The Sec. IV laws by name, as laws_for builds them (decisive: the corrected ones).
+std::vector<SkippedLaw> sec4_laws(const std::string& reason) {
+  return {{"eps", "eq28-printed", false, reason},        {"eps", "eq28-paper-route", false, reason},
+          {"eps", "eq28-corrected", true, reason},       {"omega_x_after", "eq33-printed", false, reason},
+          {"omega_x_after", "eq33-corrected", true, reason}};
+}
+
+// The laws of the requested outputs only: contact laws if `contact`, impact laws if the
+// experiment has impacts (the planner turns impacts off when restitution is not requested).
+// `impact_laws`: the Sec. IV laws describe every drop; when some drops did not impact, the eps
+// sample is truncated and those laws do not apply. `note` collects laws that were not tested,
+// `skipped` lists them.
+std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact, bool impact_laws, std::string& note,
+                             std::vector<SkippedLaw>* skipped = nullptr) {
+  const auto& p = e.sphere;
+  const double R = p.radius;
+  const auto n = p.asperities;
+  std::vector<LawSet> sets;
+  if (contact) {
+    const Law rx = exact_sphere_rx(n, R);  // tabulated once, shared by r_x and r_y
+    sets = {{"r_xy", {eq14_rxy(n, R), exact_sphere_rxy(n, R)}, {true, true}, {false, false}},
+            {"r_x", {eq18_rx(n, R), rx}, {true, true}, {false, false}},
+            {"r_y", {eq18_rx(n, R), rx}, {true, true}, {false, false}}};
+  }
+  // The Sec. IV laws assume eps_t = 1 and a horizontal spin.
+  if (e.impact.enabled && !impact_laws) {
+    note = " Sec. IV laws not tested: some drops did not impact (contact point not approaching the plate), so the "
+           "eps and Omega'_x samples are truncated.";
+    if (skipped) *skipped = sec4_laws("some drops did not impact: the eps and Omega'_x samples are truncated");
+  } else if (e.impact.enabled && e.impact.eps_t == 1.0 && e.impact.omega.z() == 0.0) {
+    ImpactScene x = impact_scene(e);
+    ImpactScene physical = x;
+    physical.core_contacts = true;  // explicit geometry lets the bare sphere touch: so must the law
+    // Far outside the paper's regime (e.g. spin >> speed) a law's distribution cannot be built
+    // (Boost rejects its parameters): report that instead of failing the whole run.
+    try {
+      const auto par = impact_law_parameters(physical);
+      LawSet eps{"eps", {eq28_printed(x), eq28_paper_route(x), eq28_corrected(physical)}, {false, false, true},
+                 {false, false, true}, par.eps_n, par.p_core};
+      LawSet wx{"omega_x_after", {eq33_printed(x), eq33_corrected(physical)}, {false, true}, {false, true},
+                x.omega_x, par.p_core};
+      sets.push_back(std::move(eps));
+      sets.push_back(std::move(wx));
+    } catch (const std::exception& ex) {
+      note = std::string(" Sec. IV laws not tested: they cannot be evaluated at these parameters (") + ex.what() + ").";
+      if (skipped) *skipped = sec4_laws(std::string("cannot be evaluated at these parameters: ") + ex.what());
+    }
+  }
+  return sets;
+}
+
+const std::vector<double>& column(const ContactSamples& s, const std::string& q) {
+  if (q == "r_xy") return s.r_xy;
+  if (q == "r_x") return s.r_x;
+  if (q == "r_y") return s.r_y;
+  if (q == "eps") return s.eps;
+  if (q == "omega_x_after") return s.omega_x_after;
+  return s.r_z;
+}
+
+// Display scale and unit of a quantity in the table (JSON is always SI).
+double display_scale(const std::string& q) { return q.rfind("r_", 0) == 0 ? 1e6 : 1.0; }
+std::string si_unit(const std::string& q) {
+  if (q == "eps") return "1";
+  if (q == "omega_x_after") return "rad/s";
+  return "m";
+}
+
+std::string fmt(double v, int prec = 4) {
+  if (std::isnan(v)) return "-";
+  std::ostringstream os;
+  os << std::setprecision(prec) << v;
+  return os.str();
+}
+
+nlohmann::json plan_json(const std::vector<PlanStage>& plan) {
+  using nlohmann::json;
+  json out = json::array();
+  for (const auto& st : plan)
+    out.push_back({{"stage", st.name}, {"run", st.run}, {"reason", st.reason},
+                   {"seconds", st.run ? json(st.seconds) : json(nullptr)}});
+  return out;
+}
+
+nlohmann::json timings_json(const std::vector<std::pair<std::string, double>>& timings) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [k, v] : timings) out[k] = v;
+  return out;
+}
+
+}  // namespace
+
+bool GeometryReport::rejected() const {
+  return std::any_of(tests.begin(), tests.end(), [](const TestReport& t) { return t.decisive && t.verdict == "reject"; });
+}
+
+std::size_t GeometryReport::skipped() const {
+  return static_cast<std::size_t>(
+      std::count_if(tests.begin(), tests.end(), [](const TestReport& t) { return t.decisive && t.verdict == "skipped"; }));
+}
+
+GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
+  GeometryReport r;
+  r.scene = scene;
+  const auto& sp = scene.ensemble.sphere;
+  const bool fixed = s.mode == Mode::fixed;
+  const std::size_t n = s.r_xy.size();
+  r.samples = n;
+  r.core_contacts = s.core_contacts;
+  r.core_probability = core_contact_probability(sp.asperities, sp.radius, sp.asperity_radius);
+  r.core_probability_paper = core_contact_probability_paper(sp.asperities, sp.radius, sp.asperity_radius);
+  r.index_bytes = s.index_bytes;
+  {
+    auto g = sorted(s.gap);
+    r.gap_min = g.front();
+    r.gap_median = quantile_sorted(g, 0.5);
+  }
+  const std::size_t K = fixed ? scene.ensemble.spheres : n, M = fixed ? n / K : 1;
+  if (fixed) {
+    r.quenched_scale = quenched_deviation_scale(sp.asperities);
+    std::ostringstream os;
+    os << "fixed ensemble: " << K << " explicit sphere(s) x " << M
+       << " rotations. Rotations of one sphere sample that sphere's own (quenched) law, which differs from the "
+          "ensemble law by a KS distance of order "
+       << fmt(r.quenched_scale, 3) << " per sphere (~0.23/sqrt(N)); pooled over K spheres, ~"
+       << fmt(r.quenched_scale / std::sqrt(double(K)), 3) << ". Statistical KS noise of the pooled sample is ~"
+       << fmt(kKsMean / std::sqrt(double(n)), 3)
+       << ", so the pooled tests are expected to reject once rotations per sphere exceed ~14N. Standard errors come "
+          "from the spread between spheres (batch means); decisive tests use one rotation per sphere (iid).";
+    r.ensemble_note = os.str();
+  } else {
+    r.ensemble_note =
+        "fresh ensemble: a new random sphere for every drop (the ensemble of the paper's Eqs. 13/14/18); "
+        "drops are iid. Only the asperities that can touch are generated (exact order statistics).";
+  }
+
+  std::vector<std::string> names;
+  if (scene.contact_stats) names = {"r_xy", "r_x", "r_y", "r_z"};
+  // Impact quantities are batched by sphere only when every drop impacted (no drop missing).
+  const bool impact = scene.ensemble.impact.enabled && s.eps.size() >= 2;
+  if (impact) names.insert(names.end(), {"eps", "omega_x_after"});
+  for (const auto& q : names) {
+    const auto& x = column(s, q);
+    // One rotation per sphere (M = 1) is iid: batch means need M >= 2.
+    const bool batched = fixed && x.size() == n && M >= 2;
+    r.quantities.push_back({q, batched ? summarize_batches(x, K, kProbs) : summarize_iid(x, kProbs)});
+  }
+  if (impact) {
+    std::vector<double> deficit(s.eps.size());
+    for (std::size_t i = 0; i < deficit.size(); ++i) deficit[i] = s.eps_n[i] - s.eps[i];
+    const bool batched = fixed && deficit.size() == n && M >= 2;
+    const Summary d = batched ? summarize_batches(deficit, K, kProbs) : summarize_iid(deficit, kProbs);
+    r.eps_deficit = d.mean;
+    double en = 0;
+    for (double e : s.eps_n) en += e;
+    r.eps_n_mean = en / double(s.eps_n.size());
+  }
+  r.no_impacts = s.no_impacts;
+
+  std::string law_note;
+  const bool impact_laws = s.no_impacts == 0 && s.eps.size() == n;
+  std::vector<SkippedLaw> skipped;
+  const auto law_sets = laws_for(scene.ensemble, scene.contact_stats, impact_laws, law_note, &skipped);
+  r.ensemble_note += law_note;
+  // A law that cannot be evaluated is listed with verdict "skipped" (p and D null): in fixed mode
+  // as the pooled test and as the decisive one-per-sphere test it would have had.
+  const auto skip = [&](const std::string& quantity, const std::string& law, bool decisive_law, std::size_t count,
+                        const std::string& reason) {
+    const std::string note = "not tested: " + reason;
+    r.tests.push_back({quantity, law, fixed ? "pooled" : "all", "KS", kNaN, kNaN, count, kNaN, !fixed,
+                       !fixed && decisive_law, "skipped", note});
+    if (fixed)
+      r.tests.push_back({quantity, law, "one-per-sphere", "KS", kNaN, kNaN, K, kNaN, true, decisive_law, "skipped", note});
+  };
+  for (const auto& set : law_sets) {
+    const auto& x = column(s, set.quantity);
+    if (x.empty()) continue;
+    const bool all_drops = x.size() == n;
+    const auto all = sorted(x);
+    std::vector<double> first;
+    std::vector<std::uint8_t> first_core;
+    if (fixed && all_drops) {
+      for (std::size_t k = 0; k < K; ++k) {
+        first.push_back(x[k * M]);
+        // eps_core runs parallel to eps, which has every drop only when every drop impacted.
+        if (s.eps_core.size() == n) first_core.push_back(s.eps_core[k * M]);
+      }
+    }
+    for (std::size_t li = 0; li < set.laws.size(); ++li) {
+      const Law& law = set.laws[li];
+      const bool decisive_law = set.decisive[li];
+      const double mean = law.mean;
+      TestReport t{set.quantity, law.name, fixed ? "pooled" : "all", "KS", 0, 1, x.size(), mean, !fixed,
+                   !fixed && decisive_law, "", ""};
+      if (!decisive_law) t.note = "as printed in the paper; reported for comparison, not decisive";
+      const bool atom = li < set.has_atom.size() && set.has_atom[li];
+      KsResult ks;
+      try {
+        ks = atom ? ks_mixed(x, s.eps_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
+                  : ks_one_sample(all, law.cdf);
+      } catch (const std::exception& ex) {
+        // Only the Sec. IV laws can fail here, far outside the paper's regime: say so, test the rest.
+        r.ensemble_note += " Law " + law.name + " not tested: it cannot be evaluated at these parameters (" +
+                           ex.what() + ").";
+        skip(set.quantity, law.name, decisive_law, x.size(),
+             std::string("cannot be evaluated at these parameters: ") + ex.what());
+        continue;
+      }
+      if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
+      t.D = ks.D, t.p = ks.p;
+      if (!fixed) {
+        t.verdict = ks.p < scene.alpha ? "reject" : "accept";
+      } else {
+        const double expected = std::hypot(kKsMean / std::sqrt(double(n)), r.quenched_scale / std::sqrt(double(K)));
+        if (ks.p >= scene.alpha) {
+          t.verdict = "accept";
+        } else if (ks.D < 4.0 * expected) {
+          t.verdict = "quenched";
+          t.note = "deviation of the size expected from quenched disorder (D < 4 x " + fmt(expected, 3) + ")";
+        } else {
+          t.verdict = "reject";
+          t.note = "larger than the expected quenched deviation " + fmt(expected, 3);
+        }
+        if (t.note.empty()) t.note = "p-value assumes iid drops; rotations of one sphere are correlated";
+        r.tests.push_back(t);
+        if (first.empty()) continue;
+        // The decisive test: one rotation per sphere gives K iid draws of the ensemble law.
+        KsResult ks1;
+        try {
+          ks1 = atom ? ks_mixed(first, first_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
+                     : ks_one_sample(sorted(first), law.cdf);
+        } catch (const std::exception& ex) {
+          r.tests.push_back({set.quantity, law.name, "one-per-sphere", "KS", kNaN, kNaN, K, mean, true, decisive_law,
+                             "skipped", std::string("not tested: cannot be evaluated at these parameters: ") + ex.what()});
+          continue;
+        }
+        TestReport t1{set.quantity, law.name, "one-per-sphere", "KS", ks1.D, ks1.p, K, mean, true, decisive_law,
+                      ks1.p < scene.alpha ? "reject" : "accept", "first rotation of each sphere: iid"};
+        r.tests.push_back(t1);
+        continue;
+      }
+      r.tests.push_back(t);
+    }
+  }
+
+  for (const auto& l : skipped) skip(l.quantity, l.law, l.decisive, column(s, l.quantity).size(), l.reason);
+
+  if (scene.contact_stats) {
+    // Core contacts: binomial(drops, P_core) for fresh spheres; two-sided exact p-value.
+    TestReport t{"core_contacts", "exact-sphere", fixed ? "pooled" : "all", "binomial", kNaN, 1, n,
+                 r.core_probability * double(n), !fixed, !fixed, "", ""};
+    boost::math::binomial_distribution<double> b(double(n), r.core_probability);
+    const double k = double(s.core_contacts);
+    const double lower = boost::math::cdf(b, k);
+    const double upper = k > 0 ? boost::math::cdf(boost::math::complement(b, k - 1)) : 1.0;
+    t.p = std::min(1.0, 2.0 * std::min(lower, upper));
+    t.verdict = t.p < scene.alpha ? (fixed ? "quenched" : "reject") : "accept";
+    t.note = "central sphere touched first; the paper's estimate exp(-N a/R) = " + fmt(r.core_probability_paper, 3) +
+             " per drop, exact (1 - a/2R)^N = " + fmt(r.core_probability, 3);
+    r.tests.push_back(t);
+  }
+  r.timings_s = {{"generate", s.seconds_generate}, {"index", s.seconds_index}, {"query", s.seconds_query}};
+  if (scene.ensemble.impact.enabled) r.timings_s.emplace_back("impact", s.seconds_impact);
+  return r;
+}
+
+std::string format_table(const GeometryReport& r) {
+  std::ostringstream os;
+  const auto& sp = r.scene.ensemble.sphere;
+  os << "validate-geometry: scene " << r.scene.name << ", " << to_string(r.scene.ensemble.mode) << " ensemble, N = "
+     << sp.asperities << ", R = " << sp.radius << " m, a = " << sp.asperity_radius << " m, " << r.samples
+     << " drops, seed " << r.scene.ensemble.seed << "\n";
+  os << "lengths in micrometres, omega in rad/s; KS = one-sample Kolmogorov-Smirnov, alpha = " << r.scene.alpha << " per test\n\n";
+  os << std::left << std::setw(14) << "quantity" << std::setw(24) << "measured mean +- se" << std::setw(18) << "law"
+     << std::setw(12) << "law mean" << std::setw(16) << "scope" << std::setw(10) << "KS D" << std::setw(11) << "p"
+     << "verdict\n";
+  os << std::string(112, '-') << "\n";
+  for (const auto& t : r.tests) {
+    std::string measured = "-";
+    const double scale = display_scale(t.quantity);
+    if (t.quantity == "core_contacts") {
+      measured = std::to_string(r.core_contacts);
+    } else {
+      const int digits = t.quantity == "eps" ? 8 : 5;
+      for (const auto& q : r.quantities)
+        if (q.name == t.quantity)
+          measured = fmt(q.summary.mean.value * scale, digits) + " +- " + fmt(q.summary.mean.se * scale, 2);
+    }
+    std::string verdict = t.verdict;
+    if (!t.decisive) verdict += " (info)";
+    os << std::left << std::setw(14) << t.quantity << std::setw(24) << measured << std::setw(18) << t.law
+       << std::setw(12) << fmt(t.predicted_mean * scale, t.quantity == "eps" ? 8 : 5) << std::setw(16) << t.scope << std::setw(10) << fmt(t.D, 3)
+       << std::setw(11) << fmt(t.p, 3) << verdict << "\n";
+  }
+  os << "\ncore contacts: " << r.core_contacts << " of " << r.samples << " drops (expected "
+     << fmt(r.core_probability * double(r.samples), 4) << "; paper's estimate per drop " << fmt(r.core_probability_paper, 3)
+     << ")\n";
+  if (r.scene.ensemble.impact.enabled) {
+    const auto& x = r.scene.ensemble.impact;
+    os << "impact: u = " << x.speed << " m/s, Omega = (" << x.omega.x() << ", " << x.omega.y() << ", " << x.omega.z()
+       << ") rad/s, eps_t = " << x.eps_t << ", Pade [1/4] beta = " << x.beta << "; mean eps_n = " << fmt(r.eps_n_mean, 8)
+       << ", deficit eps_n - <eps> = " << fmt(r.eps_deficit.value, 4) << " +- " << fmt(r.eps_deficit.se, 2)
+       << "; drops without impact: " << r.no_impacts << "\n";
+  }
+  os << "runner-up gap: min " << fmt(r.gap_min * 1e9, 4) << " nm, median " << fmt(r.gap_median * 1e9, 4) << " nm\n";
+  os << r.ensemble_note << "\n";
+  os << "verdict: " << (r.rejected() ? "a law was REJECTED" : "no law rejected");
+  if (const std::size_t k = r.skipped(); k > 0)
+    os << "; " << k << " decisive test" << (k == 1 ? "" : "s") << " SKIPPED (could not be evaluated, see the notes)";
+  os << "\n";
+  for (const auto& t : r.tests)  // the rows show the others
+    if (t.decisive && t.verdict == "skipped")
+      os << "skipped: " << t.quantity << " " << t.law << " (" << t.scope << "): " << t.note << "\n";
+  return os.str();
+}
+
+std::string to_json(const GeometryReport& r) {
+  using nlohmann::json;
+  const auto& e = r.scene.ensemble;
+  json j;
+  j["schema_version"] = kReportSchemaVersion;
+  j["tool"] = "validate-geometry";
+  j["scene"] = r.scene.name;
+  j["mode"] = std::string(to_string(e.mode));
+  j["samples"] = r.samples;
+  j["core_contacts"] = r.core_contacts;
+  j["core_contact_probability"] = {{"exact", r.core_probability}, {"paper", r.core_probability_paper}};
+  j["parameters"] = {{"asperities", e.sphere.asperities},
+                     {"radius_m", e.sphere.radius},
+                     {"asperity_radius_m", e.sphere.asperity_radius},
+                     {"drops", e.drops},
+                     {"spheres", e.mode == Mode::fixed ? e.spheres : e.drops},
+                     {"rotations_per_sphere", e.mode == Mode::fixed ? e.drops / e.spheres : 1},
+                     {"seed", e.seed},
+                     {"backend", e.mode == Mode::fixed ? std::string(to_string(e.backend)) : std::string("none")},
+                     {"alpha", r.scene.alpha}};
+  if (e.impact.enabled) {
+    const auto& x = e.impact;
+    j["impact"] = {{"speed_m_s", x.speed},
+                   {"omega_rad_s", {x.omega.x(), x.omega.y(), x.omega.z()}},
+                   {"density_kg_m3", x.density},
+                   {"beta", x.beta},
+                   {"eps_t", x.eps_t},
+                   {"restitution_model", "viscoelastic-pade14"},
+                   {"solver", "closed form (Sherman-Morrison), tested against the general 3x3 solve"}};
+    j["no_impacts"] = r.no_impacts;
+    j["eps_n_mean"] = r.eps_n_mean;
+    j["eps_deficit"] = {{"value", r.eps_deficit.value}, {"se", r.eps_deficit.se}};
+  }
+  j["ensemble_note"] = r.ensemble_note;
+  if (e.mode == Mode::fixed) j["quenched_deviation_scale"] = r.quenched_scale;
+  j["runner_up_gap_m"] = {{"min", r.gap_min}, {"median", r.gap_median}};
+  json q = json::object();
+  for (const auto& qr : r.quantities) {
+    const auto& s = qr.summary;
+    json qs = json::array();
+    for (std::size_t i = 0; i < s.probs.size(); ++i)
+      qs.push_back({{"p", s.probs[i]}, {"value", s.quantiles[i].value}, {"se", s.quantiles[i].se}});
+    q[qr.name] = {{"unit", si_unit(qr.name)},     {"n", s.n},       {"mean", s.mean.value}, {"mean_se", s.mean.se},
+                  {"std", s.std.value}, {"std_se", s.std.se}, {"quantiles", qs},   {"se_batches", s.batches}};
+  }
+  j["quantities"] = q;
+  json tests = json::array();
+  for (const auto& t : r.tests) {
+    tests.push_back({{"quantity", t.quantity},
+                     {"law", t.law},
+                     {"scope", t.scope},
+                     {"statistic", t.statistic},
+                     {"D", std::isnan(t.D) ? json(nullptr) : json(t.D)},
+                     {"p", std::isnan(t.p) ? json(nullptr) : json(t.p)},
+                     {"n", t.n},
+                     {"predicted_mean", t.predicted_mean},
+                     {"iid", t.iid},
+                     {"decisive", t.decisive},
+                     {"verdict", t.verdict},
+                     {"note", t.note}});
+  }
+  j["tests"] = tests;
+  j["rejected"] = r.rejected();
+  j["skipped"] = r.skipped();
+  j["timings_s"] = timings_json(r.timings_s);
+  if (r.index_bytes) j["index_bytes_per_asperity"] = double(r.index_bytes) / double(e.sphere.asperities);
+  j["plots"] = r.plots;
+  if (!r.plan.empty()) j["plan"] = plan_json(r.plan);
+  if (!r.scene_toml.empty()) j["scene_file"] = r.scene_toml;
+  return j.dump(2) + "\n";
+}
+
+
+std::string with_header(const std::string& body, const ReportHeader& h) {
+  using nlohmann::json;
+  json j = json::parse(body);
+  if (!j.is_object()) throw std::invalid_argument("with_header: the report body must be a JSON object");
+  j["schema_version"] = kReportSchemaVersion;
+  j["tool"] = h.tool;
+  j["scene"] = h.scene;
+  if (!h.scene_toml.empty()) j["scene_file"] = h.scene_toml;
+  if (!h.plan.empty()) j["plan"] = plan_json(h.plan);
+  if (!h.timings_s.empty()) j["timings_s"] = timings_json(h.timings_s);
+  return j.dump(2) + "\n";
+}
+
+std::vector<std::filesystem::path> write_report_files(const std::filesystem::path& dir, const std::string& report_name,
+                                                      const std::string& json, const std::string& table) {
+  const std::filesystem::path report = dir / report_name;
+  std::filesystem::path txt = report;
+  txt.replace_extension(".txt");
+  if (txt == report) txt += ".txt";  // a report named "x.txt" keeps its table apart
+  write_file_atomic(report, json);
+  try {
+    write_file_atomic(txt, table);
+  } catch (...) {
+    std::error_code ec;
+    std::filesystem::remove(report, ec);
+    throw;
+  }
+  return {report, txt};
+}
+
+std::vector<std::string> write_plots(const std::filesystem::path& dir, const Scene& scene, const ContactSamples& s) {
+  std::vector<std::string> files;
+  const auto& sp = scene.ensemble.sphere;
+  const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * areal_density(sp.asperities, sp.radius));
+  std::ostringstream sub;
+  sub << "N = " << sp.asperities << ", {/Symbol r} = " << sp.asperity_radius << " m, " << to_string(scene.ensemble.mode)
+      << ", n = " << s.r_xy.size();
+  std::string law_note;  // the report says why a law is missing
+  for (const auto& set : laws_for(scene.ensemble, scene.contact_stats,
+                                  s.no_impacts == 0 && s.eps.size() == s.r_xy.size(), law_note)) {
+    const auto& x = column(s, set.quantity);
+    if (x.empty()) continue;
+    HistogramFigure fig;
+    double lo, hi;
+    if (set.quantity.rfind("r_", 0) == 0) {
+      const bool radial = set.quantity == "r_xy";
+      hi = std::min(sp.radius, (radial ? 4.5 : 4.0) * sigma);
+      lo = radial ? 0.0 : -hi;
+      const std::string sym = radial ? "r_{xy}" : (set.quantity == "r_x" ? "r_x" : "r_y");
+      fig.title = sym + " of the contact vector: " + sub.str();
+      fig.xlabel = sym + " [{/Symbol m}m]";
+      fig.x_scale = 1e6;
+      fig.y_scale = 1e-6;
+      fig.ylabel = "probability density [1/{/Symbol m}m]";
+    } else {
+      // Range from the data: the bulk plus the tails the log panel shows.
+      auto v = sorted(x);
+      lo = quantile_sorted(v, 1e-4), hi = quantile_sorted(v, 1.0 - 1e-5);
+      const double pad = 0.05 * (hi - lo);
+      lo -= pad, hi += pad;
+      if (!(hi > lo)) lo -= 1e-12, hi += 1e-12;
+      const bool eps = set.quantity == "eps";
+      fig.title = (eps ? std::string("{/Symbol e}") : std::string("{/Symbol W}'_x")) + ": " + sub.str();
+      fig.xlabel = eps ? "{/Symbol e}" : "{/Symbol W}'_x [rad/s]";
+      fig.ylabel = eps ? "probability density" : "probability density [s/rad]";
+    }
+    fig.histogram = make_histogram(x, lo, hi, 60);
+    for (const auto& law : set.laws) {
+      const std::string label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
+                                : law.name == "eq18" ? "Eq. (18), Gaussian"
+                                : law.name == "exact-sphere" ? "exact finite-N law on the sphere"
+                                                             : law.name;
+      fig.curves.push_back(sampled_curve(law.pdf, label, lo, hi));
+    }
+    const std::string name = set.quantity + ".png";
+    write_histogram_png(dir / name, fig);
+    files.push_back(name);
+  }
+  return files;
+}
+
+}  // namespace asperity

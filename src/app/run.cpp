@@ -1,0 +1,341 @@
+#include "asperity/app/run.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <sstream>
+
+#include "asperity/experiments/body_bounce.hpp"
+#include "asperity/experiments/body_experiments.hpp"
+#include "asperity/experiments/bounce.hpp"
+#include "asperity/app/experiment_reports.hpp"
+#include "asperity/app/mesh_io.hpp"
+#include "asperity/app/plot.hpp"
+#include "asperity/app/scene_file.hpp"
+
+namespace asperity {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Asperity radii of a scene: its distribution, or the paper's one radius.
+RadiusDistribution scene_radii(const Scene& s) {
+  return s.radii ? s.radii->radii : RadiusDistribution::fixed(s.ensemble.sphere.asperity_radius);
+}
+
+MeshImpactExperiment mesh_experiment(const Scene& s) {
+  const auto& e = s.ensemble;
+  MeshImpactExperiment m;
+  m.mesh = s.mesh->file;
+  m.scale = s.mesh->scale;
+  m.smooth_ellipsoid = s.mesh->smooth;
+  m.asperities = e.sphere.asperities;
+  m.radii = scene_radii(s);
+  if (s.radii) m.screen_bodies = s.radii->screen_bodies, m.screen_directions = s.radii->screen_directions;
+  m.density = e.impact.density;
+  m.bodies = e.spheres;
+  m.drops = e.drops;
+  m.speed = e.impact.speed;
+  m.omega = e.impact.omega;
+  m.beta = e.impact.beta;
+  m.eps_t = e.impact.eps_t;
+  m.seed = e.seed;
+  m.alpha = s.alpha;
+  m.plots = s.plots;
+  return m;
+}
+
+RadiiExperiment radii_experiment(const Scene& s) {
+  const auto& e = s.ensemble;
+  RadiiExperiment r;
+  r.asperities = e.sphere.asperities;
+  r.radius = e.sphere.radius;
+  r.radii = s.radii->radii;
+  r.drops = e.drops;
+  r.screen_bodies = s.radii->screen_bodies;
+  r.screen_directions = s.radii->screen_directions;
+  r.seed = e.seed;
+  r.alpha = s.alpha;
+  r.plots = s.plots;
+  return r;
+}
+
+std::vector<std::string> skipped_of(const std::vector<LawCheck>& tests) {
+  std::vector<std::string> out;
+  for (const auto& t : tests)
+    if (t.decisive && t.verdict == "skipped") out.push_back(t.quantity + " " + t.law + ": " + t.note);
+  return out;
+}
+
+// The header of a run of `s` from its plan; timings_s lists the stages that ran.
+ReportHeader header_of(const Scene& s, std::vector<PlanStage> plan) {
+  ReportHeader h;
+  h.scene = s.name;
+  h.scene_toml = to_toml(s);
+  for (const auto& st : plan)
+    if (st.run) h.timings_s.emplace_back(st.name, st.seconds);
+  h.plan = std::move(plan);
+  return h;
+}
+
+PlanStage stage(std::string name, bool run, std::string reason, double seconds = 0) {
+  return {std::move(name), run, std::move(reason), run ? seconds : 0.0};
+}
+
+PlanStage plots_stage(const Scene& s, double seconds) {
+  return stage("plots", s.plots, s.plots ? "outputs.plots" : "plots = false / --no-plots", seconds);
+}
+
+PlanStage export_stage(const Scene& s, double seconds) {
+  const bool on = !s.mesh->export_ply.empty();
+  return stage("export", on, on ? "outputs.export_ply: the first body as PLY" : "no outputs.export_ply", seconds);
+}
+
+// The first body of a mesh scene (same seed and index as the run's body 0) as PLY.
+void export_first_body(const Scene& s, const TriangleMesh& mesh) {
+  const double density = s.ensemble.impact.density;
+  const RoughBody b = make_rough_mesh_body(mesh, s.ensemble.sphere.asperities, scene_radii(s), density, s.ensemble.seed, 0,
+                                           smooth_surface(s.mesh->smooth), s.mesh->file.stem().string());
+  write_ply(s.out / s.mesh->export_ply, b, s.mesh->export_points ? PlyStyle::points : PlyStyle::spheres, 1.0, &mesh,
+            -mass_properties(mesh, density).centroid);
+}
+
+SceneOutput run_radii(const Scene& s, const Progress& progress) {
+  RadiiReport r = run_radii_experiment(radii_experiment(s), progress);
+  if (s.plots) {
+    const auto t0 = Clock::now();
+    r.plots = write_figures(s.out, r.figures);
+    r.seconds_plots = since(t0);
+  }
+  const bool lognormal = s.radii->radii.kind == RadiusDistribution::Kind::lognormal;
+  SceneOutput o;
+  o.files = r.plots;
+  o.rejected = r.rejected();
+  o.skipped = skipped_of(r.tests);
+  o.table = format_table(r);
+  const ReportHeader h = header_of(
+      s, {stage("screening", true,
+                "lambda_eff: " + std::to_string(s.radii->screen_bodies) + " explicit spheres screened" +
+                (lognormal ? ", rotated for r_x (no exact sampler for lognormal radii)" : ""),
+                r.seconds_screen),
+          stage("query", !lognormal,
+                lognormal ? "lognormal radii: r_x comes from rotations of the screened spheres"
+                : "fresh drops: exact sampler of the lowest asperities (level radii)",
+                r.seconds_fresh),
+          stage("analysis", true, "r_x against the exact level law and Gaussians with lambda, lambda_eff",
+                r.seconds_analysis),
+          plots_stage(s, r.seconds_plots)});
+  o.json = with_header(to_json(r), h);
+  return o;
+}
+
+SceneOutput run_mesh(const Scene& s, const Progress& progress) {
+  const MeshImpactExperiment m = mesh_experiment(s);
+  const TriangleMesh mesh = read_mesh(m.mesh, m.scale);
+  SceneOutput o;
+  double seconds_export = 0;
+  if (!s.mesh->export_ply.empty()) {
+    const auto t0 = Clock::now();
+    o.files.push_back(s.mesh->export_ply);  // listed first: removed if anything below fails
+    export_first_body(s, mesh);
+    seconds_export = since(t0);
+  }
+  MeshImpactReport r = run_mesh_impacts(m, mesh, progress);
+  if (s.plots) {
+    const auto t0 = Clock::now();
+    r.plots = write_figures(s.out, r.figures);
+    r.seconds_plots = since(t0);
+  }
+  o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
+  o.rejected = r.rejected();
+  o.skipped = skipped_of(r.tests);
+  o.table = format_table(r);
+  const ReportHeader h = header_of(
+      s, {stage("generate", true, "mesh, mass properties and the comparison sphere", r.seconds_mesh),
+          stage("query", true,
+                std::to_string(m.bodies) + " explicit bodies x rotations: support tree, lowest asperity, impact",
+                r.seconds_drops),
+          stage("analysis", true, "summaries; the sphere laws of the equal-volume sphere (measurements)",
+                r.seconds_analysis),
+          plots_stage(s, r.seconds_plots),
+          export_stage(s, seconds_export)});
+  o.json = with_header(to_json(r), h);
+  return o;
+}
+
+SceneOutput run_bounce(const Scene& s, std::ostream* log) {
+  const auto& e = s.ensemble;
+  SceneOutput o;
+  auto t0 = Clock::now();
+  const auto reports = run_bounce_experiment(e.sphere, s.bounce, e.seed, e.threads, log);
+  const double seconds_bounce = since(t0);
+  t0 = Clock::now();
+  const auto comparisons = compare_bounce_variants(reports);
+  std::ostringstream table;
+  table << format_bounce_table(reports);
+  for (const auto& c : comparisons)
+    table << "KS " << to_string(c.a) << " vs " << to_string(c.b) << ", " << c.by << " [" << c.lo << ", " << c.hi
+          << "]: D = " << c.ks.D << ", p = " << c.ks.p << "\n";
+  const double seconds_analysis = since(t0);
+  t0 = Clock::now();
+  std::vector<std::string> plots;
+  if (s.plots) plots = write_bounce_plots(s.out, reports);
+  o.files = plots;
+  const double seconds_plots = since(t0);
+  o.table = table.str();
+  const ReportHeader h =
+      header_of(s, {stage("bounce", true, "bounce sequences per variant, fits and bootstrap goodness of fit", seconds_bounce),
+                    stage("analysis", true, "two-sample KS between variants", seconds_analysis),
+                    plots_stage(s, seconds_plots)});
+  o.json = with_header(bounce_to_json(s.name, e.sphere, s.bounce, e.seed, reports, plots, comparisons), h);
+  return o;
+}
+
+SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
+  const auto& e = s.ensemble;
+  MeshBounceExperiment m;
+  m.mesh = s.mesh->file;
+  m.scale = s.mesh->scale;
+  m.smooth = s.mesh->smooth;
+  m.asperities = e.sphere.asperities;
+  m.radii = scene_radii(s);
+  m.density = e.impact.density;
+  m.bodies = e.spheres;
+  m.seed = e.seed;
+  m.threads = e.threads;
+  m.options.bounce = s.bounce;
+  m.plots = s.plots;
+  const std::optional<TriangleMesh> mesh =
+      m.mesh.empty() ? std::nullopt : std::optional<TriangleMesh>(read_mesh(m.mesh, m.scale));
+  SceneOutput o;
+  double seconds_export = 0;
+  if (!s.mesh->export_ply.empty()) {
+    const auto t0 = Clock::now();
+    o.files.push_back(s.mesh->export_ply);
+    export_first_body(s, *mesh);
+    seconds_export = since(t0);
+  }
+  MeshBounceReport r = run_mesh_bounces(m, mesh ? &*mesh : nullptr, progress);
+  if (s.plots) {
+    const auto t0 = Clock::now();
+    r.plots = write_mesh_bounce_plots(s.out, r);
+    r.seconds_plots = since(t0);
+  }
+  o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
+  o.table = format_table(r);
+  const ReportHeader h = header_of(
+      s, {stage("generate", true, std::to_string(m.bodies) + " rough bodies from the mesh", r.seconds_build),
+          stage("index", true, "one exact support tree per body, shared by the threads", r.seconds_index),
+          stage("bounce", true,
+                "sequences: impacts (3x3 solve), free rotation and conservative advancement to each landing",
+                r.seconds_run),
+          stage("analysis", true, "speed windows, impact numbers, Eq. 2 fits (descriptive), energy checks",
+                r.seconds_analysis),
+          plots_stage(s, r.seconds_plots),
+          export_stage(s, seconds_export)});
+  o.json = with_header(to_json(r), h);
+  return o;
+}
+
+SceneOutput run_sphere(const Scene& s, const Progress& progress) {
+  const GeometryReport r = run_scene(s, progress);
+  SceneOutput o;
+  o.files = r.plots;
+  o.rejected = r.rejected();
+  for (const auto& t : r.tests)
+    if (t.decisive && t.verdict == "skipped") o.skipped.push_back(t.quantity + " " + t.law + " (" + t.scope + "): " + t.note);
+  o.table = format_table(r);
+  ReportHeader h;
+  h.scene = r.scene.name;
+  h.scene_toml = r.scene_toml;
+  h.plan = r.plan;
+  h.timings_s = r.timings_s;
+  o.json = with_header(to_json(r), h);
+  return o;
+}
+
+}  // namespace
+
+GeometryReport run_scene(const Scene& s, const Progress& progress) {
+  validate(s);
+  Plan plan = make_plan(s);
+  const Scene& run = plan.scene;
+  const ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
+  auto t0 = Clock::now();
+  GeometryReport r = analyse(run, samples);
+  r.timings_s.emplace_back("analysis", since(t0));
+  plan.stage("analysis").seconds = r.timings_s.back().second;
+  if (plan.runs("plots")) {
+    t0 = Clock::now();
+    r.plots = write_plots(run.out, run, samples);
+    r.timings_s.emplace_back("plots", since(t0));
+    plan.stage("plots").seconds = r.timings_s.back().second;
+  }
+  plan.stage("generate").seconds = samples.seconds_generate;
+  plan.stage("index").seconds = samples.seconds_index;
+  plan.stage("query").seconds = samples.seconds_query;
+  plan.stage("impact").seconds = samples.seconds_impact;
+  r.plan = std::move(plan.stages);
+  r.scene_toml = to_toml(s);
+  return r;
+}
+
+RunKind run_kind(const Scene& s) {
+  if (s.bounce.enabled) return s.mesh ? RunKind::mesh_bounce : RunKind::bounce;
+  if (s.mesh) return RunKind::mesh;
+  if (s.radii) return RunKind::radii;
+  return RunKind::sphere;
+}
+
+std::string_view to_string(RunKind k) {
+  switch (k) {
+    case RunKind::sphere: return "sphere";
+    case RunKind::radii: return "radii";
+    case RunKind::mesh: return "mesh";
+    case RunKind::bounce: return "bounce";
+    case RunKind::mesh_bounce: return "mesh-bounce";
+  }
+  return "?";
+}
+
+SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log) {
+  validate(s);
+#ifdef _OPENMP
+  if (s.ensemble.threads > 0) omp_set_num_threads(s.ensemble.threads);  // as run_contact_ensemble does
+#endif
+  // Names the run may write into s.out; whatever exists of them afterwards on failure is its own.
+  namespace fs = std::filesystem;
+  std::vector<fs::path> before;
+  std::error_code ec;
+  if (fs::is_directory(s.out, ec))
+    for (const auto& f : fs::directory_iterator(s.out, ec)) before.push_back(f.path());
+  try {
+    SceneOutput o;
+    switch (run_kind(s)) {
+      case RunKind::sphere: o = run_sphere(s, progress); break;
+      case RunKind::radii: o = run_radii(s, progress); break;
+      case RunKind::mesh: o = run_mesh(s, progress); break;
+      case RunKind::bounce: o = run_bounce(s, log); break;
+      case RunKind::mesh_bounce: o = run_mesh_bounce(s, progress); break;
+    }
+    o.kind = run_kind(s);
+    return o;
+  } catch (...) {
+    // Remove the files that appeared during this run (figures, PLY): no partial output.
+    if (fs::is_directory(s.out, ec))
+      for (const auto& f : fs::directory_iterator(s.out, ec))
+        if (std::find(before.begin(), before.end(), f.path()) == before.end() && f.is_regular_file(ec))
+          fs::remove(f.path(), ec);
+    throw;
+  }
+}
+
+}  // namespace asperity

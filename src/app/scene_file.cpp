@@ -1,0 +1,744 @@
+// Scene files (format 1). toml++ is used header-only, in this translation unit only.
+#include "asperity/app/scene_file.hpp"
+
+#define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
+#include <toml++/toml.h>
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+
+namespace asperity {
+
+namespace {
+
+// Shortest text that reads back as the same double, and is a TOML float (not an integer).
+std::string num(double v) {
+  char buf[64];
+  const auto res = std::to_chars(buf, buf + sizeof buf, v);
+  std::string s(buf, res.ptr);
+  if (std::isfinite(v) && s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string quote(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (u < 0x20 || u == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", u);
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+// A value as the user wrote it, for messages.
+std::string show(const toml::node& n) {
+  if (auto f = n.as_floating_point()) return num(f->get());
+  if (auto i = n.as_integer()) return std::to_string(i->get());
+  if (auto s = n.as_string()) return quote(s->get());
+  if (auto b = n.as_boolean()) return b->get() ? "true" : "false";
+  if (n.is_array()) return "an array";
+  if (n.is_table()) return "a table";
+  return "a date/time";
+}
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::string: return "string";
+    case toml::node_type::integer: return "integer";
+    case toml::node_type::floating_point: return "float";
+    case toml::node_type::boolean: return "boolean";
+    case toml::node_type::array: return "array";
+    case toml::node_type::table: return "table";
+    default: return "date/time";
+  }
+}
+
+// One TOML table being read: remembers which keys were read, so that every other key is an
+// error naming its full dotted path.
+class Reader {
+ public:
+  Reader(const toml::table& t, std::string path, std::string_view origin) : t_(t), path_(std::move(path)), origin_(origin) {}
+
+  std::string key(std::string_view k) const { return path_.empty() ? std::string(k) : path_ + "." + std::string(k); }
+
+  // "<origin>:<line>: <message>", thrown as SceneError carrying the key.
+  [[noreturn]] void fail(const toml::node* at, const std::string& key, const std::string& message) const {
+    std::string where(origin_);
+    const auto line = at ? at->source().begin.line : t_.source().begin.line;
+    if (line > 0) where += ":" + std::to_string(line);
+    throw SceneError(where + ": " + message, key);
+  }
+  [[noreturn]] void bad(std::string_view k, const std::string& problem) const {
+    fail(t_.get(k), key(k), key(k) + ": " + problem);
+  }
+  [[noreturn]] void unsupported(std::string_view k, const std::string& why) const {
+    const toml::node* n = t_.get(k);
+    fail(n, key(k), "not supported yet: " + key(k) + " = " + (n ? show(*n) : "?") + " (" + why + ")");
+  }
+
+  const toml::node* find(std::string_view k) {
+    used_.insert(std::string(k));
+    return t_.get(k);
+  }
+  bool has(std::string_view k) const { return t_.contains(k); }
+
+  void finish() const {
+    for (auto&& [k, v] : t_)
+      if (!used_.count(std::string(k.str()))) fail(&v, key(k.str()), "unknown key '" + key(k.str()) + "'");
+  }
+
+  std::optional<double> real(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    double v = 0;
+    if (auto f = n->as_floating_point()) {
+      v = f->get();
+    } else if (auto i = n->as_integer()) {
+      v = static_cast<double>(i->get());
+    } else {
+      bad(k, "expected a number, got " + show(*n) + " (" + type_name(*n) + ")");
+    }
+    if (!std::isfinite(v)) bad(k, "must be finite, got " + show(*n));
+    return v;
+  }
+  std::optional<double> positive(std::string_view k, const char* unit) {
+    const auto v = real(k);
+    if (v && !(*v > 0)) bad(k, "must be > 0 " + std::string(unit) + ", got " + show(*t_.get(k)));
+    return v;
+  }
+  // Whole numbers, written as integers or exactly as floats ("1e6").
+  std::optional<std::uint64_t> count(std::string_view k, std::uint64_t lo, std::uint64_t hi) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    long double v = 0;
+    if (auto i = n->as_integer()) {
+      v = static_cast<long double>(i->get());
+    } else if (auto f = n->as_floating_point()) {
+      v = f->get();
+      if (!std::isfinite(f->get())) bad(k, "must be finite, got " + show(*n));
+      if (v != std::floor(v)) bad(k, "must be a whole number, got " + show(*n));
+    } else {
+      bad(k, "expected a whole number, got " + show(*n) + " (" + type_name(*n) + ")");
+    }
+    if (v < static_cast<long double>(lo)) bad(k, "must be >= " + std::to_string(lo) + ", got " + show(*n));
+    if (v > static_cast<long double>(hi)) bad(k, "must be <= " + std::to_string(hi) + ", got " + show(*n));
+    return static_cast<std::uint64_t>(v);
+  }
+  std::optional<bool> boolean(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    if (auto b = n->as_boolean()) return b->get();
+    bad(k, "expected true or false, got " + show(*n) + " (" + type_name(*n) + ")");
+  }
+  std::optional<std::string> text(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto s = n->as_string();
+    if (!s) bad(k, "expected a string, got " + show(*n) + " (" + type_name(*n) + ")");
+    if (s->get().empty()) bad(k, "must not be empty");
+    return s->get();
+  }
+  // One of `choices`, named in the message.
+  std::optional<std::string> choice(std::string_view k, std::initializer_list<std::string_view> choices) {
+    auto v = text(k);
+    if (!v) return v;
+    std::string list;
+    for (auto c : choices) {
+      if (*v == c) return v;
+      list += (list.empty() ? "" : ", ") + quote(c);
+    }
+    bad(k, "expected one of " + list + ", got " + quote(*v));
+  }
+  std::optional<Vec3> vec3(std::string_view k, const char* unit) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto a = n->as_array();
+    if (!a || a->size() != 3) bad(k, std::string("expected an array of 3 numbers [") + unit + "], got " + show(*n));
+    Vec3 v;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const toml::node& e = *a->get(i);
+      if (auto f = e.as_floating_point()) {
+        v[static_cast<Eigen::Index>(i)] = f->get();
+      } else if (auto j = e.as_integer()) {
+        v[static_cast<Eigen::Index>(i)] = static_cast<double>(j->get());
+      } else {
+        bad(k, "element " + std::to_string(i) + " must be a number, got " + show(e));
+      }
+      if (!std::isfinite(v[static_cast<Eigen::Index>(i)])) bad(k, "element " + std::to_string(i) + " must be finite, got " + show(e));
+    }
+    return v;
+  }
+  std::optional<std::vector<double>> reals(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto a = n->as_array();
+    if (!a || a->empty()) bad(k, "expected a non-empty array of numbers, got " + show(*n));
+    std::vector<double> out;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      const toml::node& e = *a->get(i);
+      double v = 0;
+      if (auto f = e.as_floating_point()) v = f->get();
+      else if (auto j = e.as_integer()) v = static_cast<double>(j->get());
+      else bad(k, "element " + std::to_string(i) + " must be a number, got " + show(e));
+      if (!std::isfinite(v)) bad(k, "element " + std::to_string(i) + " must be finite, got " + show(e));
+      out.push_back(v);
+    }
+    return out;
+  }
+  // A sub-table (a [section] or an inline { ... } table).
+  std::optional<Reader> table(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto t = n->as_table();
+    if (!t) bad(k, "expected a table, got " + show(*n) + " (" + type_name(*n) + ")");
+    return Reader(*t, key(k), origin_);
+  }
+  [[noreturn]] void missing(std::string_view k, const std::string& hint) const {
+    fail(nullptr, key(k), key(k) + ": missing (" + hint + ")");
+  }
+
+ private:
+  const toml::table& t_;
+  std::string path_;
+  std::string_view origin_;
+  std::set<std::string> used_;
+};
+
+constexpr std::uint64_t kMaxAsperities = (std::uint64_t{1} << 32) - 1;  // geometry.hpp: N < 2^32
+constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
+
+// THE mapping from a scene file to a Scene: every section and key of format 1 is read here, and
+// nowhere else. New engine features (mesh bodies, radius distributions, bounce experiments, ...)
+// are wired in by replacing the matching `unsupported(...)` with a field of Scene.
+Scene scene_from_toml(const toml::table& root, std::string_view origin) {
+  Reader top(root, "", origin);
+  Scene s;
+  const auto format = top.count("format", 1, std::numeric_limits<std::int64_t>::max());
+  if (!format) top.missing("format", "write format = " + std::to_string(kSceneFormatVersion) + " as the first line");
+  if (*format != kSceneFormatVersion)
+    top.bad("format", "this library reads format " + std::to_string(kSceneFormatVersion) + ", got " +
+                          std::to_string(*format));
+  s.name = top.text("name").value_or("custom");
+
+  // [body]
+  double R = s.ensemble.sphere.radius;
+  if (auto body = top.table("body")) {
+    const auto kind = body->choice("kind", {"sphere", "mesh"}).value_or("sphere");
+    if (kind == "mesh") {
+      MeshBodyScene m;
+      const auto file = body->text("mesh");
+      if (!file) body->missing("mesh", "a mesh file (OFF/PLY/STL/OBJ), e.g. mesh = \"../meshes/ellipsoid.off\"");
+      m.file = *file;
+      if (auto sc = body->positive("scale", "(mesh units -> m)")) m.scale = *sc;
+      if (auto sm = body->reals("smooth")) {
+        if (sm->size() != 3 && sm->size() != 4)
+          body->bad("smooth", "expected [a, b, c] or [a, b, c, m] [m], got " + std::to_string(sm->size()) + " numbers");
+        for (std::size_t i = 0; i < sm->size(); ++i)
+          if (!((*sm)[i] > 0)) body->bad("smooth", "element " + std::to_string(i) + " must be > 0, got " + num((*sm)[i]));
+        m.smooth = *sm;
+      }
+      if (body->has("radius")) body->bad("radius", "only for kind = \"sphere\" (a mesh body's size is the mesh x scale)");
+      s.mesh = std::move(m);
+    } else {
+      for (const char* k : {"mesh", "scale", "smooth"})
+        if (body->has(k)) body->bad(k, "only for kind = \"mesh\"");
+    }
+    if (auto r = body->positive("radius", "m")) R = *r;
+    body->finish();
+  }
+  s.ensemble.sphere.radius = R;
+
+  // [material]
+  auto& impact = s.ensemble.impact;
+  if (auto mat = top.table("material")) {
+    if (auto d = mat->positive("density", "kg/m^3")) impact.density = *d;
+    if (auto e = mat->real("eps_t")) {
+      if (*e < -1 || *e > 1) mat->bad("eps_t", "must be in [-1, 1], got " + num(*e));
+      impact.eps_t = *e;
+    }
+    if (auto rest = mat->table("restitution")) {
+      const auto model = rest->choice("model", {"viscoelastic", "constant"});
+      if (!model) rest->missing("model", "\"viscoelastic\" (with beta) or \"constant\" (with value)");
+      if (*model == "viscoelastic") {
+        const auto beta = rest->positive("beta", "(s/m)^(1/5)");
+        if (!beta) rest->missing("beta", "Pade [1/4] constant of Eq. 9, e.g. 0.0467 for steel");
+        impact.beta = *beta;
+      } else {
+        if (auto v = rest->real("value"); v && (*v < 0 || *v > 1))
+          rest->bad("value", "must be in [0, 1], got " + num(*v));
+        rest->unsupported("model", "impacts use the viscoelastic model only");
+      }
+      rest->finish();
+    }
+    mat->finish();
+  }
+
+  // [asperities]
+  if (auto asp = top.table("asperities")) {
+    const auto n = asp->count("count", 1, kMaxAsperities);
+    const auto eta = asp->positive("areal_density", "per m^2");
+    if (n && eta) asp->bad("areal_density", "give either count or areal_density, not both");
+    if (eta && s.mesh) asp->bad("areal_density", "a mesh body needs count (N per body), got areal_density = " + num(*eta));
+    if (n) s.ensemble.sphere.asperities = *n;
+    if (eta) {
+      const double count = std::round(*eta * 4.0 * std::numbers::pi * R * R);
+      if (!(count >= 1) || count > double(kMaxAsperities))
+        asp->bad("areal_density", num(*eta) + " per m^2 on a sphere of radius " + num(R) + " m gives " + num(count) +
+                                      " asperities; need 1 .. 2^32-1");
+      s.ensemble.sphere.asperities = static_cast<std::uint64_t>(count);
+    }
+    if (auto rad = asp->table("radius")) {
+      const auto dist = rad->choice("distribution", {"fixed", "lognormal", "levels"});
+      if (!dist) rad->missing("distribution", "\"fixed\" (with value), \"lognormal\" or \"levels\"");
+      if (*dist == "fixed") {
+        const auto a = rad->positive("value", "m");
+        if (!a) rad->missing("value", "the asperity radius a [m]");
+        if (!s.mesh && *a >= R) rad->bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
+        s.ensemble.sphere.asperity_radius = *a;
+      } else if (*dist == "lognormal") {
+        const auto median = rad->positive("median", "m");
+        if (!median) rad->missing("median", "the median asperity radius exp(mu) [m]");
+        const auto sigma = rad->real("sigma");
+        if (!sigma) rad->missing("sigma", "the standard deviation of ln(radius), e.g. 0.3");
+        if (*sigma < 0) rad->bad("sigma", "must be >= 0, got " + num(*sigma));
+        if (!s.mesh && *median >= R) rad->bad("median", num(*median) + " m must be smaller than body.radius = " + num(R) + " m");
+        s.radii = RadiiScene{RadiusDistribution::lognormal(*median, *sigma)};
+      } else {
+        const auto radii = rad->reals("radii");
+        const auto fractions = rad->reals("fractions");
+        if (radii)
+          for (double r : *radii)
+            if (!(r > 0)) rad->bad("radii", "every radius must be > 0 m, got " + num(r));
+        if (fractions) {
+          double sum = 0;
+          for (double f : *fractions) {
+            if (!(f > 0)) rad->bad("fractions", "every fraction must be > 0, got " + num(f));
+            sum += f;
+          }
+          if (std::abs(sum - 1.0) > 1e-9) rad->bad("fractions", "must sum to 1, got " + num(sum));
+        }
+        if (!radii) rad->missing("radii", "the level radii [m], e.g. [1.3e-6, 6.5e-7]");
+        if (!fractions) rad->missing("fractions", "one probability per radius, summing to 1, e.g. [0.2, 0.8]");
+        if (radii->size() != fractions->size())
+          rad->bad("fractions", "needs one fraction per radius (" + std::to_string(radii->size()) + "), got " +
+                                    std::to_string(fractions->size()));
+        if (!s.mesh)
+          for (double r : *radii)
+            if (r >= R) rad->bad("radii", num(r) + " m must be smaller than body.radius = " + num(R) + " m");
+        s.radii = RadiiScene{RadiusDistribution::discrete(*radii, *fractions)};
+      }
+      rad->finish();
+    }
+    asp->finish();
+  }
+  if (!s.mesh && s.ensemble.sphere.asperity_radius >= R)
+    top.fail(nullptr, "body.radius",
+             "body.radius: " + num(R) + " m must exceed the asperity radius " + num(s.ensemble.sphere.asperity_radius) + " m");
+
+  // [ensemble]
+  auto& e = s.ensemble;
+  if (auto ens = top.table("ensemble")) {
+    if (auto m = ens->choice("mode", {"fresh", "fixed"})) e.mode = parse_mode(*m);
+    if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
+    if (auto k = ens->count("spheres", 1, kMaxDrops)) {
+      if (e.mode == Mode::fresh && *k != 1)
+        ens->bad("spheres", "only mode = \"fixed\" uses explicit spheres (fresh mode draws a new sphere per drop), got " +
+                                std::to_string(*k));
+      e.spheres = *k;
+    }
+    if (e.mode == Mode::fixed && e.drops % e.spheres != 0)
+      ens->bad("drops", std::to_string(e.drops) + " must be a multiple of ensemble.spheres = " + std::to_string(e.spheres));
+    if (const toml::node* seed = ens->find("seed")) {
+      // Integers up to 2^63 - 1; larger 64-bit seeds as a string of digits.
+      if (auto i = seed->as_integer()) {
+        if (i->get() < 0) ens->bad("seed", "must be >= 0, got " + show(*seed));
+        e.seed = static_cast<std::uint64_t>(i->get());
+      } else if (auto str = seed->as_string()) {
+        const std::string& t = str->get();
+        const auto res = std::from_chars(t.data(), t.data() + t.size(), e.seed);
+        if (t.empty() || res.ec != std::errc() || res.ptr != t.data() + t.size())
+          ens->bad("seed", "expected a non-negative 64-bit integer, got " + show(*seed));
+      } else {
+        ens->bad("seed", "expected a non-negative integer, got " + show(*seed) + " (" + type_name(*seed) + ")");
+      }
+    }
+    if (auto b = ens->choice("backend", {"auto", "brute", "kdtree", "cgal", "fcl", "grid"})) {
+      s.backend_auto = *b == "auto";
+      if (!s.backend_auto) e.backend = parse_backend(*b);
+      if (e.mode == Mode::fresh && !s.backend_auto)  // a key that cannot apply is refused, never ignored
+        ens->bad("backend", "only mode = \"fixed\" queries a contact index (fresh mode draws the lowest asperities "
+                            "exactly): \"auto\" or absent, got \"" + *b + "\"");
+    }
+    if (auto t = ens->count("threads", 0, 4096)) e.threads = static_cast<int>(*t);
+    ens->finish();
+  }
+
+  // Mesh bodies and unequal radii are runs of body_experiments.hpp: explicit bodies with the exact
+  // support tree, so the ensemble keys that choose a contact backend or a mode do not apply.
+  if (s.mesh && e.mode != Mode::fixed)
+    top.fail(nullptr, "ensemble.mode",
+             "ensemble.mode: a mesh body needs mode = \"fixed\" (ensemble.spheres explicit bodies x rotations), got \"" +
+                 std::string(to_string(e.mode)) + "\"");
+  if (s.radii && !s.mesh && e.mode != Mode::fresh)
+    top.fail(nullptr, "ensemble.mode",
+             "ensemble.mode: unequal asperity radii on a sphere draw fresh spheres (mode = \"fresh\") and screen "
+             "[screening] bodies explicit ones, got \"" + std::string(to_string(e.mode)) + "\"");
+  if ((s.mesh || s.radii) && !s.backend_auto)
+    top.fail(nullptr, "ensemble.backend",
+             "ensemble.backend: mesh bodies and unequal asperity radii use the exact support tree; only \"auto\", got \"" +
+                 std::string(to_string(e.backend)) + "\"");
+
+  // [screening]: unequal radii (sphere: lambda_eff of run_radii_experiment; mesh: screen_body).
+  if (auto scr = top.table("screening")) {
+    if (!s.radii)
+      scr->fail(nullptr, "screening", "screening: only for unequal asperity radii (asperities.radius distribution "
+                                      "\"levels\" or \"lognormal\")");
+    if (auto b = scr->count("bodies", 1, 1u << 20)) s.radii->screen_bodies = *b;
+    if (auto d = scr->count("directions", 1, kMaxDrops)) s.radii->screen_directions = *d;
+    scr->finish();
+  }
+  if (s.radii && !s.mesh && s.radii->radii.kind == RadiusDistribution::Kind::lognormal &&
+      e.drops % s.radii->screen_bodies != 0)
+    top.fail(nullptr, "ensemble.drops",
+             "ensemble.drops: " + std::to_string(e.drops) + " must be a multiple of screening.bodies = " +
+                 std::to_string(s.radii->screen_bodies) + " (lognormal radii: r_x comes from rotations of the screened bodies)");
+
+  // [experiment]
+  bool impacts = false;
+  if (auto ex = top.table("experiment")) {
+    const auto kind = ex->choice("kind", {"contact", "impact", "bounce"}).value_or("contact");
+    impacts = kind == "impact";
+    if (kind == "bounce") {
+      // Sec. V: sequences of impacts from `speed` down to `stop_speed`, Omega = 0 at the start.
+      s.bounce.enabled = true;
+      if (auto u = ex->positive("speed", "m/s")) s.bounce.speed = *u;
+      if (auto u = ex->positive("stop_speed", "m/s")) s.bounce.stop_speed = *u;
+      if (auto g = ex->positive("gravity", "m/s^2")) s.bounce.gravity = *g;
+      if (auto n = ex->count("sequences", 1, std::uint64_t{1} << 31)) s.bounce.sequences = *n;
+      if (auto v = ex->text("variants")) {
+        s.bounce.variants.clear();
+        std::size_t pos = 0;
+        try {
+          do {
+            const std::size_t comma = v->find(',', pos);
+            s.bounce.variants.push_back(parse_bounce_variant(v->substr(pos, comma - pos)));
+            pos = comma == std::string::npos ? comma : comma + 1;
+          } while (pos != std::string::npos);
+        } catch (const std::invalid_argument& err) {
+          ex->bad("variants", err.what());
+        }
+      }
+      if (!(s.bounce.stop_speed < s.bounce.speed))
+        ex->bad("stop_speed", "must be below speed = " + num(s.bounce.speed) + " m/s, got " + num(s.bounce.stop_speed));
+      // A body bounces one way: its orientation carried by the free rotation (body_bounce.hpp).
+      if (s.mesh) {
+        if (ex->has("variants") && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
+          ex->bad("variants", "a mesh body bounces with its orientation carried by the free rotation: only \"dynamic\"");
+        s.bounce.variants = {BounceVariant::dynamic};
+        if (const auto W = ex->vec3("Omega", "rad/s")) s.bounce.omega = *W;
+      } else if (ex->has("Omega")) {
+        ex->bad("Omega", "only for body.kind = \"mesh\": the sphere's bounce variants start without spin (Sec. V)");
+      }
+    } else {
+      for (const char* k : {"speed", "stop_speed", "gravity", "sequences", "variants"})
+        if (ex->has(k)) ex->bad(k, "only for kind = \"bounce\"");
+    }
+    if (impacts) {
+      const auto V = ex->vec3("V", "m/s");
+      const auto Omega = ex->vec3("Omega", "rad/s");
+      if (!V) ex->missing("V", "velocity before the impact [m/s], e.g. [0, 0, -1.3]");
+      if (!Omega) ex->missing("Omega", "spin before the impact [rad/s], e.g. [0.2, 0, 0]");
+      if (!((*V)[2] < 0)) ex->bad("V", "the body must approach the plate below it (V.z < 0), got V.z = " + num((*V)[2]));
+      if ((*V)[0] != 0 || (*V)[1] != 0)
+        ex->unsupported("V", "only vertical impacts V = [0, 0, -u] are in the engine yet");
+      impact.speed = -(*V)[2];
+      impact.omega = *Omega;
+    } else {
+      for (const char* k : {"V", "Omega"})
+        if (ex->has(k) && !(s.bounce.enabled && s.mesh && std::string(k) == "Omega"))
+          ex->bad(k, s.bounce.enabled ? "only for kind = \"impact\" (a bounce starts at V = [0, 0, -speed])"
+                                      : "only for kind = \"impact\"");
+    }
+    ex->finish();
+  }
+  impact.enabled = impacts;
+  if (s.mesh && !impacts && !s.bounce.enabled)
+    top.fail(nullptr, "experiment.kind",
+             "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega) or \"bounce\"");
+  if (s.mesh && impacts && s.ensemble.drops % s.ensemble.spheres != 0)
+    top.fail(nullptr, "ensemble.drops", "ensemble.drops: must be a multiple of ensemble.spheres");
+  if (s.radii && !s.mesh && (impacts || s.bounce.enabled))
+    top.fail(nullptr, "experiment.kind",
+             "experiment.kind: unequal asperity radii on a sphere are analysed as contacts only; use kind = \"contact\"");
+  if (s.bounce.enabled) {  // the material applies to every impact of a sequence
+    s.bounce.density = impact.density, s.bounce.beta = impact.beta, s.bounce.eps_t = impact.eps_t;
+  }
+
+  // [outputs]
+  if (auto out = top.table("outputs")) {
+    if (auto c = out->boolean("contact")) s.contact_stats = *c;
+    if (auto r = out->boolean("restitution")) {
+      if (*r && !impacts && !s.bounce.enabled)
+        out->bad("restitution", "true needs experiment.kind = \"impact\" or \"bounce\"");
+      s.restitution_stats = *r;
+    }
+    if (!s.bounce.enabled && !s.contact_stats && !(impacts && s.restitution_stats))
+      out->bad("contact", "nothing to compute: request contact = true, or restitution = true with an impact experiment");
+    if (auto p = out->boolean("plots")) s.plots = *p;
+    if (auto a = out->real("alpha")) {
+      if (!(*a > 0 && *a < 1)) out->bad("alpha", "must be in (0, 1), got " + num(*a));
+      s.alpha = *a;
+    }
+    if (auto d = out->text("dir")) s.out = *d;
+    if (auto r = out->text("report")) {
+      if (r->find('/') != std::string::npos || *r == "." || *r == "..")
+        out->bad("report", "must be a file name inside outputs.dir, got " + quote(*r));
+      s.report = *r;
+    }
+    if (auto p = out->text("export_ply")) {
+      if (!s.mesh) out->bad("export_ply", "only for body.kind = \"mesh\"");
+      if (p->find('/') != std::string::npos || *p == "." || *p == "..")
+        out->bad("export_ply", "must be a file name inside outputs.dir, got " + quote(*p));
+      s.mesh->export_ply = *p;
+    }
+    if (auto st = out->choice("export_style", {"spheres", "points"})) {
+      if (!s.mesh || s.mesh->export_ply.empty()) out->bad("export_style", "only with outputs.export_ply");
+      s.mesh->export_points = *st == "points";
+    }
+    if (s.mesh && !(s.contact_stats && s.restitution_stats))
+      out->bad(s.contact_stats ? "restitution" : "contact", "a mesh body's run always analyses contacts and restitution");
+    out->finish();
+  }
+  top.finish();
+
+  // The engine's own checks, as a net: the keys above should already have caught everything.
+  try {
+    validate(s);
+  } catch (const std::invalid_argument& ex) {
+    top.fail(nullptr, "", ex.what());
+  }
+  return s;
+}
+
+// toml++ 3.3 (Debian 12) violates its own precondition on a table header whose name does not
+// start with a key character ("[\n", "[[=", "[[[1]]"): an assertion failure in debug builds,
+// undefined behaviour (__builtin_assume) in clang release builds (upstream marzer/tomlplusplus
+// PR #301). Such headers are never valid TOML, so they are refused here, before toml++ sees them.
+// Returns the 1-based line of the first one, 0 if there is none. Tracks strings, comments and
+// multi-line arrays so that a '[' inside a value is not taken for a header.
+struct SyntaxProblem {
+  std::size_t line = 0;  // 0: none found
+  const char* what = "";
+};
+
+SyntaxProblem bad_brackets(std::string_view t) {
+  std::size_t line = 1;
+  bool line_start = true, in_header = false;
+  std::string open;  // the [ and { open inside a value, innermost last
+  const std::size_t n = t.size();
+  // Scene files are ASCII: toml++ 3.3 reaches TOML_UNREACHABLE (undefined behaviour) classifying
+  // some non-ASCII characters, in bare keys and inside strings alike (found by fuzzing).
+  for (std::size_t i = 0, l = 1; i < n; ++i) {
+    if (t[i] == '\n') ++l;
+    if (static_cast<unsigned char>(t[i]) >= 0x80) return {l, "a non-ASCII byte (scene files are ASCII)"};
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = t[i];
+    if (c == '\n') {
+      ++line;
+      in_header = false;
+      if (open.empty()) line_start = true;
+      continue;
+    }
+    if (c == ' ' || c == '\t' || c == '\r') continue;
+    if (c == '#') {
+      while (i + 1 < n && t[i + 1] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {
+      line_start = false;
+      if (i + 2 < n && t[i + 1] == c && t[i + 2] == c) {  // multi-line string
+        const std::string_view close = c == '"' ? std::string_view("\"\"\"") : std::string_view("'''");
+        i += 3;
+        while (i < n && t.substr(i, 3) != close) {
+          if (c == '"' && t[i] == '\\' && i + 1 < n) ++i;  // an escape (maybe a line-ending backslash)
+          if (t[i] == '\n') ++line;
+          ++i;
+        }
+        i += 2;  // at the last quote of the closing triple (the loop's ++i steps past it)
+      } else {
+        ++i;
+        while (i < n && t[i] != c && t[i] != '\n') {
+          if (c == '"' && t[i] == '\\') ++i;
+          ++i;
+        }
+        if (i < n && t[i] == '\n') --i;  // unterminated: let the newline be counted
+      }
+      continue;
+    }
+    if (line_start && open.empty() && c == '[') {
+      std::size_t j = i + 1;
+      if (j < n && t[j] == '[') ++j;
+      while (j < n && (t[j] == ' ' || t[j] == '\t')) ++j;
+      if (j < n) {
+        const char k = t[j];
+        const bool key_start = (k >= 'A' && k <= 'Z') || (k >= 'a' && k <= 'z') || (k >= '0' && k <= '9') ||
+                               k == '_' || k == '-' || k == '"' || k == '\'';
+        if (!key_start) return {line, "a table header must start with a key, e.g. [body]"};
+      }
+      in_header = true;
+      line_start = false;
+      i = j - 1;
+      continue;
+    }
+    line_start = false;
+    if (in_header) continue;
+    if (c == '[' || c == '{') {
+      open.push_back(c);
+    } else if ((c == ']' || c == '}') && !open.empty()) {
+      // toml++ 3.3 asserts (debug) or misbehaves on a closer that does not match, e.g. [0, 1,}2].
+      if ((c == ']') != (open.back() == '[')) return {line, c == ']' ? "']' closes an inline table" : "'}' closes an array"};
+      open.pop_back();
+    }
+  }
+  return {};
+}
+
+// body.mesh relative to the scene file's directory, then to the meshes/ of the source tree and of
+// the installation (by the path as written, then by its file name).
+std::filesystem::path resolve_mesh(const std::filesystem::path& mesh, const std::filesystem::path& scene_file,
+                                   const std::filesystem::path& scene_dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::vector<fs::path> tried;
+  if (mesh.is_absolute()) {
+    tried.push_back(mesh);
+  } else {
+    tried.push_back(scene_dir.empty() ? mesh : scene_dir / mesh);
+    for (const char* dir_name : {ASPERITY_SOURCE_MESHES_DIR, ASPERITY_INSTALL_MESHES_DIR}) {
+      const fs::path dir(dir_name);
+      tried.push_back(dir / mesh);
+      tried.push_back(dir / mesh.filename());
+    }
+  }
+  for (const auto& p : tried)
+    if (fs::is_regular_file(p, ec)) return p.lexically_normal();
+  std::string where;
+  for (const auto& p : tried) where += (where.empty() ? "" : ", ") + p.string();
+  throw SceneError(scene_file.string() + ": body.mesh: mesh file " + quote(mesh.string()) + " not found (looked for " +
+                       where + ")",
+                   "body.mesh");
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view toml_text, std::string_view origin) {
+  if (const SyntaxProblem bad = bad_brackets(toml_text); bad.line != 0)
+    throw SceneError(std::string(origin) + ":" + std::to_string(bad.line) + ": TOML syntax error: " + bad.what, "");
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, std::string(origin));
+  } catch (const toml::parse_error& e) {
+    throw SceneError(std::string(origin) + ":" + std::to_string(e.source().begin.line) + ": TOML syntax error: " +
+                         std::string(e.description()),
+                     "");
+  }
+  return scene_from_toml(root, origin);
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  std::ifstream f(file, std::ios::binary);
+  std::error_code ec;
+  if (!f || std::filesystem::is_directory(file, ec)) throw SceneError("cannot read scene file '" + file.string() + "'", "");
+  std::ostringstream text;
+  text << f.rdbuf();
+  if (!f && !f.eof()) throw SceneError("cannot read scene file '" + file.string() + "'", "");
+  Scene s = parse_scene(text.str(), file.string());
+  if (s.mesh) s.mesh->file = resolve_mesh(s.mesh->file, file, file.parent_path());
+  return s;
+}
+
+std::string to_toml(const Scene& s) {
+  const auto& e = s.ensemble;
+  const auto& x = e.impact;
+  std::ostringstream os;
+  os << "# asperity scene (README \"Scenes\")\n";
+  os << "format = " << kSceneFormatVersion << "\n";
+  os << "name = " << quote(s.name) << "\n\n";
+  if (s.mesh) {
+    os << "[body]\nkind = \"mesh\"\nmesh = " << quote(s.mesh->file.string()) << "\nscale = " << num(s.mesh->scale) << "\n";
+    if (!s.mesh->smooth.empty()) {
+      os << "smooth = [";
+      for (std::size_t i = 0; i < s.mesh->smooth.size(); ++i) os << (i ? ", " : "") << num(s.mesh->smooth[i]);
+      os << "]\n";
+    }
+    os << "\n";
+  } else {
+    os << "[body]\nkind = \"sphere\"\nradius = " << num(e.sphere.radius) << "\n\n";
+  }
+  os << "[material]\ndensity = " << num(x.density) << "\neps_t = " << num(x.eps_t)
+     << "\nrestitution = { model = \"viscoelastic\", beta = " << num(x.beta) << " }\n\n";
+  os << "[asperities]\ncount = " << e.sphere.asperities << "\n";
+  if (!s.radii) {
+    os << "radius = { distribution = \"fixed\", value = " << num(e.sphere.asperity_radius) << " }\n\n";
+  } else if (const auto& d = s.radii->radii; d.kind == RadiusDistribution::Kind::lognormal) {
+    os << "radius = { distribution = \"lognormal\", median = " << num(d.median) << ", sigma = " << num(d.sigma) << " }\n\n";
+  } else {
+    auto list = [](const std::vector<double>& v) {
+      std::string t = "[";
+      for (std::size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + num(v[i]);
+      return t + "]";
+    };
+    os << "radius = { distribution = \"levels\", radii = " << list(d.levels) << ", fractions = " << list(d.fractions)
+       << " }\n\n";
+  }
+  if (s.radii)
+    os << "[screening]\nbodies = " << s.radii->screen_bodies << "\ndirections = " << s.radii->screen_directions << "\n\n";
+  os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\n";
+  if (e.mode == Mode::fixed) os << "spheres = " << e.spheres << "\n";  // fresh mode has no explicit spheres
+  os << "seed = ";
+  if (e.seed > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
+    os << quote(std::to_string(e.seed));
+  else
+    os << e.seed;
+  os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::fresh ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
+     << e.threads << "\n\n";
+  if (s.bounce.enabled) {
+    const auto& b = s.bounce;
+    os << "[experiment]\nkind = \"bounce\"\nspeed = " << num(b.speed) << "\nstop_speed = " << num(b.stop_speed)
+       << "\ngravity = " << num(b.gravity) << "\nsequences = " << b.sequences << "\nvariants = \"";
+    for (std::size_t i = 0; i < b.variants.size(); ++i) os << (i ? "," : "") << to_string(b.variants[i]);
+    os << "\"\n";
+    if (s.mesh) os << "Omega = [" << num(b.omega.x()) << ", " << num(b.omega.y()) << ", " << num(b.omega.z()) << "]\n";
+    os << "\n";
+  } else if (x.enabled) {
+    os << "[experiment]\nkind = \"impact\"\nV = [0.0, 0.0, " << num(-x.speed) << "]\nOmega = [" << num(x.omega.x())
+       << ", " << num(x.omega.y()) << ", " << num(x.omega.z()) << "]\n\n";
+  } else {
+    os << "[experiment]\nkind = \"contact\"\n\n";
+  }
+  os << "[outputs]\ncontact = " << (s.contact_stats ? "true" : "false") << "\n";
+  if (x.enabled || !s.restitution_stats) os << "restitution = " << (s.restitution_stats ? "true" : "false") << "\n";
+  os << "plots = " << (s.plots ? "true" : "false") << "\nalpha = " << num(s.alpha) << "\ndir = " << quote(s.out.string())
+     << "\nreport = " << quote(s.report) << "\n";
+  if (s.mesh && !s.mesh->export_ply.empty())
+    os << "export_ply = " << quote(s.mesh->export_ply) << "\nexport_style = \""
+       << (s.mesh->export_points ? "points" : "spheres") << "\"\n";
+  return os.str();
+}
+
+}  // namespace asperity

@@ -1,0 +1,190 @@
+#include "asperity/core/lazy_sphere.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "asperity/core/random.hpp"
+#include "core/contact/detail.hpp"
+
+namespace asperity {
+
+std::uint64_t binomial_half(std::uint64_t n, Stream& s) {
+  if (n <= 512) {
+    std::uint64_t k = 0, left = n;
+    while (left >= 64) k += static_cast<std::uint64_t>(std::popcount(s.bits())), left -= 64;
+    if (left) k += static_cast<std::uint64_t>(std::popcount(s.bits() & ((std::uint64_t{1} << left) - 1)));
+    return k;
+  }
+  // Inversion in the order mode, mode+1, mode-1, mode+2, ... (any fixed order of the support is
+  // a valid inversion); the pmf ratios are exact rationals, the mode's pmf comes from lgamma.
+  const double dn = static_cast<double>(n);
+  const std::uint64_t mode = n / 2;
+  const double km = static_cast<double>(mode);
+  const double p_mode = std::exp(std::lgamma(dn + 1) - std::lgamma(km + 1) - std::lgamma(dn - km + 1) - dn * std::numbers::ln2);
+  double u = s.uniform0() - p_mode;
+  if (u < 0) return mode;
+  double p_up = p_mode, p_dn = p_mode;
+  std::uint64_t up = mode, dn_k = mode;
+  while (up < n || dn_k > 0) {
+    if (up < n) {
+      p_up *= static_cast<double>(n - up) / static_cast<double>(up + 1);
+      ++up;
+      u -= p_up;
+      if (u < 0) return up;
+    }
+    if (dn_k > 0) {
+      p_dn *= static_cast<double>(dn_k) / static_cast<double>(n - dn_k + 1);
+      --dn_k;
+      u -= p_dn;
+      if (u < 0) return dn_k;
+    }
+    if (p_up < 1e-300 && p_dn < 1e-300) break;
+  }
+  return mode;  // u left over by rounding (probability ~1e-16)
+}
+
+LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size)
+    : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)) {
+  if (n < 1 || n > 0xFFFFFFFFull)
+    throw std::invalid_argument("lazy sphere: asperities must be in [1, 2^32 - 1], got " + std::to_string(n));
+  reset(seed, sphere_id);
+}
+
+void LazySphere::reset(std::uint64_t seed, std::uint64_t sphere_id) {
+  seed_ = seed, sphere_ = sphere_id;
+  nodes_.clear();
+  points_.clear();
+  nodes_.push_back(Node{-1.0, 1.0, 0.0, 2.0 * std::numbers::pi, 1, n_, 0});
+}
+
+void LazySphere::expand(std::size_t i) {
+  Node c = nodes_[i];
+  Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id);
+  const std::uint64_t left = binomial_half(c.count, s);
+  // Split the longer side (arc lengths) at its equal-area midpoint.
+  const double dtheta = std::acos(std::clamp(c.z0, -1.0, 1.0)) - std::acos(std::clamp(c.z1, -1.0, 1.0));
+  const double smax = std::max(std::sqrt((1 - c.z0) * (1 + c.z0)), std::sqrt((1 - c.z1) * (1 + c.z1)));
+  const double width = (c.p1 - c.p0) * ((c.z0 <= 0 && c.z1 >= 0) ? 1.0 : smax);  // along the widest circle
+  Node a = c, b = c;
+  if (width > dtheta) {
+    const double pm = 0.5 * (c.p0 + c.p1);
+    a.p1 = pm, b.p0 = pm;
+  } else {
+    const double zm = 0.5 * (c.z0 + c.z1);
+    a.z1 = zm, b.z0 = zm;
+  }
+  a.id = 2 * c.id, b.id = 2 * c.id + 1;
+  a.count = left, b.count = c.count - left;
+  a.offset = c.offset, b.offset = c.offset + left;
+  a.child = b.child = a.points = b.points = -1;
+  nodes_[i].child = static_cast<std::int64_t>(nodes_.size());
+  nodes_.push_back(a);
+  nodes_.push_back(b);
+}
+
+void LazySphere::fill(std::size_t i) {
+  const Node& c = nodes_[i];
+  Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id + 1);
+  nodes_[i].points = static_cast<std::int64_t>(points_.size());
+  for (std::uint64_t j = 0; j < c.count; ++j) {
+    const double z = c.z0 + (c.z1 - c.z0) * s.uniform0();
+    const double phi = c.p0 + (c.p1 - c.p0) * s.uniform0();
+    const double r = std::sqrt(std::max(0.0, (1 - z) * (1 + z)));
+    points_.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+  }
+}
+
+double LazySphere::lower_key(const Node& c, const Vec3& d, double dxy, double psi) {
+  // max over the cell of u.d = s(z) dxy cos(phi - psi) + z dz, s = sqrt(1 - z^2) >= 0.
+  constexpr double two_pi = 2.0 * std::numbers::pi;
+  double cmax;
+  const double span = c.p1 - c.p0;
+  double delta = std::fmod(psi - c.p0, two_pi);
+  if (delta < 0) delta += two_pi;
+  if (delta <= span) cmax = 1.0;
+  else cmax = std::max(std::cos(c.p0 - psi), std::cos(c.p1 - psi));
+  const double A = dxy * cmax, dz = d.z();
+  auto f = [&](double z) { return A * std::sqrt(std::max(0.0, (1 - z) * (1 + z))) + dz * z; };
+  double ub;
+  if (A > 0) {
+    const double zs = dz / std::hypot(A, dz);  // unconstrained maximum of the concave f
+    ub = f(std::clamp(zs, c.z0, c.z1));
+    if (zs >= c.z0 && zs <= c.z1) ub = std::max(ub, std::hypot(A, dz));
+  } else {
+    ub = std::max(f(c.z0), f(c.z1));  // convex: maximum at an end
+  }
+  return 2.0 - 2.0 * ub - 1e-13;
+}
+
+LazyNearest LazySphere::lowest(const Vec3& d) {
+  const double dxy = std::hypot(d.x(), d.y());
+  const double psi = std::atan2(d.y(), d.x());
+  detail::TopTwo top;
+  auto& h = heap_;
+  h.clear();
+  auto cmp = std::greater<std::pair<double, std::size_t>>();
+  h.emplace_back(lower_key(nodes_[0], d, dxy, psi), 0);
+  while (!h.empty()) {
+    std::pop_heap(h.begin(), h.end(), cmp);
+    const auto [lb, i] = h.back();
+    h.pop_back();
+    if (lb > top.second_key()) break;  // no open cell can hold a better candidate
+    if (is_leaf(nodes_[i])) {
+      if (nodes_[i].points < 0) fill(i);
+      const Node& c = nodes_[i];
+      for (std::uint64_t j = 0; j < c.count; ++j)
+        top.offer(static_cast<std::uint32_t>(c.offset + j), contact_key(points_[static_cast<std::size_t>(c.points) + j], d));
+      continue;
+    }
+    if (nodes_[i].child < 0) expand(i);
+    const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
+    for (std::size_t k = ch; k < ch + 2; ++k) {
+      if (nodes_[k].count == 0) continue;
+      const double lk = lower_key(nodes_[k], d, dxy, psi);
+      if (lk > top.second_key()) continue;
+      h.emplace_back(lk, k);
+      std::push_heap(h.begin(), h.end(), cmp);
+    }
+  }
+  LazyNearest r;
+  r.nearest = top.result();
+  // Find the winner's centre: it lies in a generated leaf (offset <= index < offset + count).
+  const std::uint64_t idx = r.nearest.index;
+  std::size_t i = 0;
+  while (!is_leaf(nodes_[i])) {
+    const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
+    i = idx < nodes_[ch + 1].offset ? ch : ch + 1;
+  }
+  r.u = points_[static_cast<std::size_t>(nodes_[i].points) + (idx - nodes_[i].offset)];
+  return r;
+}
+
+std::vector<Vec3> LazySphere::materialise() {
+  std::vector<Vec3> out;
+  out.reserve(n_);
+  // Depth-first, first child first: leaves in index order.
+  std::vector<std::size_t> stack{0};
+  while (!stack.empty()) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    if (nodes_[i].count == 0) continue;
+    if (is_leaf(nodes_[i])) {
+      if (nodes_[i].points < 0) fill(i);
+      const auto p = static_cast<std::size_t>(nodes_[i].points);
+      for (std::uint64_t j = 0; j < nodes_[i].count; ++j) out.push_back(points_[p + j]);
+      continue;
+    }
+    if (nodes_[i].child < 0) expand(i);
+    const auto ch = static_cast<std::size_t>(nodes_[i].child);
+    stack.push_back(ch + 1);
+    stack.push_back(ch);
+  }
+  return out;
+}
+
+}  // namespace asperity

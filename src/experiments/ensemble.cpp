@@ -1,0 +1,256 @@
+#include "asperity/experiments/ensemble.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <numbers>
+#include <stdexcept>
+
+#include "asperity/core/impact.hpp"
+#include "asperity/core/orientation.hpp"
+#include "asperity/core/random.hpp"
+#include "core/format.hpp"
+
+namespace asperity {
+
+using detail::num;
+
+std::string_view to_string(Mode m) { return m == Mode::fresh ? "fresh" : "fixed"; }
+
+Mode parse_mode(std::string_view s) {
+  if (s == "fresh") return Mode::fresh;
+  if (s == "fixed") return Mode::fixed;
+  throw std::invalid_argument("unknown mode '" + std::string(s) + "' (expected fresh or fixed)");
+}
+
+void validate(const EnsembleConfig& c) {
+  validate(c.sphere);
+  if (c.drops < 2)
+    throw std::invalid_argument("drops must be >= 2 (a standard error needs two samples), got " + std::to_string(c.drops));
+  if (c.drops > (std::uint64_t{1} << 31))
+    throw std::invalid_argument("drops must be <= 2^31, got " + std::to_string(c.drops));
+  if (c.mode == Mode::fixed) {
+    if (c.spheres < 1) throw std::invalid_argument("spheres must be >= 1, got 0");
+    if (c.drops % c.spheres != 0)
+      throw std::invalid_argument("drops (" + std::to_string(c.drops) + ") must be a multiple of spheres (" +
+                                  std::to_string(c.spheres) + ")");
+  }
+  if (c.threads < 0 || c.threads > kMaxThreads)
+    throw std::invalid_argument("threads must be in [0, " + std::to_string(kMaxThreads) + "], got " +
+                                std::to_string(c.threads));
+  if (c.impact.enabled) {
+    const auto& x = c.impact;
+    if (!std::isfinite(x.speed) || !(x.speed > 0))
+      throw std::invalid_argument("impact speed must be finite and > 0 m/s, got " + std::to_string(x.speed));
+    if (x.speed > kMaxSpeed)
+      throw std::invalid_argument("impact speed must be <= " + num(kMaxSpeed) + " m/s (supported range), got " + num(x.speed));
+    if (!x.omega.allFinite()) throw std::invalid_argument("impact omega must be finite");
+    const double surface = x.omega.norm() * (c.sphere.radius + c.sphere.asperity_radius);
+    if (!(surface <= kMaxSpeed))
+      throw std::invalid_argument("impact spin |omega| = " + num(x.omega.norm()) + " rad/s gives a surface speed of " +
+                                  num(surface) + " m/s; must be <= " + num(kMaxSpeed) + " m/s (supported range)");
+    if (!std::isfinite(x.density) || !(x.density > 0))
+      throw std::invalid_argument("density must be finite and > 0 kg/m^3, got " + std::to_string(x.density));
+    if (!std::isfinite(x.beta) || !(x.beta > 0))
+      throw std::invalid_argument("beta must be finite and > 0, got " + std::to_string(x.beta));
+    if (!std::isfinite(x.eps_t) || x.eps_t < -1 || x.eps_t > 1)
+      throw std::invalid_argument("eps_t must be in [-1, 1], got " + std::to_string(x.eps_t));
+    const double R = c.sphere.radius, mass = 4.0 / 3.0 * std::numbers::pi * R * R * R * x.density;
+    if (!std::isnormal(mass) || !std::isnormal(0.4 * mass * R * R))
+      throw std::invalid_argument("density " + num(x.density) + " kg/m^3 with radius " + num(R) +
+                                  " m gives a mass or moment of inertia outside the range of double");
+  }
+}
+
+std::vector<Vec3> fresh_cap(std::uint64_t n, std::uint64_t drop, std::uint64_t seed, unsigned k) {
+  Stream s(seed, Purpose::fresh, drop);
+  const unsigned m = static_cast<unsigned>(std::min<std::uint64_t>(k, n));
+  std::vector<Vec3> cap;
+  cap.reserve(m);
+  double x = 0.0;  // X_(j) so far
+  for (unsigned j = 0; j < m; ++j) {
+    const double u = s.uniform(), v = s.uniform0();
+    // Minimum of n - j uniforms on (x, 1): x + (1 - x)(1 - u^(1/(n-j))); expm1/log keep it
+    // accurate when the cap is tiny (x ~ 1/N).
+    x = x + (1.0 - x) * -std::expm1(std::log(u) / static_cast<double>(n - j));
+    // Direction at polar angle theta from the SOUTH pole (-z): cos theta = 1 - 2x.
+    const double sin_t = 2.0 * std::sqrt(x * (1.0 - x));
+    const double phi = 2.0 * std::numbers::pi * v;
+    cap.emplace_back(sin_t * std::cos(phi), sin_t * std::sin(phi), -(1.0 - 2.0 * x));
+  }
+  return cap;
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void resize(ContactSamples& s, std::size_t n) {
+  s.r_x.resize(n), s.r_y.resize(n), s.r_z.resize(n), s.r_xy.resize(n), s.gap.resize(n), s.core.resize(n);
+}
+
+void store(ContactSamples& s, std::size_t i, const Contact& c) {
+  s.r_x[i] = c.r.x(), s.r_y[i] = c.r.y(), s.r_z[i] = c.r.z(), s.r_xy[i] = c.r_xy;
+  s.gap[i] = c.gap, s.core[i] = c.core ? 1 : 0;
+}
+
+// Work is cut into fixed chunks so that progress can be reported; results land at their drop
+// index, so the chunking never changes a result.
+constexpr std::uint64_t kChunk = 4096;
+
+template <class Body>
+void for_chunks(std::uint64_t total, std::uint64_t offset, std::uint64_t grand_total, const Progress& progress,
+                Body body) {
+  const std::int64_t chunks = static_cast<std::int64_t>((total + kChunk - 1) / kChunk);
+  std::atomic<std::uint64_t> done{0};
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t c = 0; c < chunks; ++c) {
+    const std::uint64_t b = static_cast<std::uint64_t>(c) * kChunk, e = std::min(total, b + kChunk);
+    body(b, e);
+    const std::uint64_t now = done.fetch_add(e - b) + (e - b);
+    if (progress && omp_get_thread_num() == 0) progress(offset + now, grand_total);
+  }
+}
+
+// One impact per drop with the closed-form impulse (tested against the general 3x3 solve).
+void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
+  const auto t0 = Clock::now();
+  const auto& x = c.impact;
+  const double R = c.sphere.radius;
+  const double mass = 4.0 / 3.0 * std::numbers::pi * R * R * R * x.density;
+  const double inertia = 0.4 * mass * R * R;  // central sphere only (paper Sec. II)
+  const auto eps_n = viscoelastic_pade14(x.beta);
+  const std::size_t n = s.r_x.size();
+  std::vector<double> eps(n), wx(n), en(n);
+  std::vector<std::uint8_t> hit(n);
+  const std::int64_t ni = static_cast<std::int64_t>(n);
+  // An exception must not leave an OpenMP region (std::terminate): keep the one of the lowest
+  // drop, so the error is the same for any thread count, and rethrow it after the loop.
+  std::exception_ptr error;
+  std::int64_t error_drop = ni;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < ni; ++i) try {
+    const std::size_t k = static_cast<std::size_t>(i);
+    ImpactState st;
+    st.V = Vec3(0, 0, -x.speed);
+    st.Omega = x.omega;
+    st.r = s.core[k] ? Vec3(0, 0, -R) : Vec3(s.r_x[k], s.r_y[k], s.r_z[k]);
+    st.n = Vec3(0, 0, 1);
+    const double vn = (st.V + st.Omega.cross(st.r)).dot(st.n);
+    if (!(vn < 0)) continue;
+    const double e = (*eps_n)(-vn);
+    const auto out = solve_impact_isotropic(mass, inertia, st, e, x.eps_t);
+    hit[k] = 1, eps[k] = out->eps, wx[k] = out->Omega_after.x(), en[k] = e;
+  } catch (...) {
+#pragma omp critical(asperity_impact_error)
+    if (i < error_drop) error_drop = i, error = std::current_exception();
+  }
+  if (error) std::rethrow_exception(error);
+  // Compact in drop order: deterministic for any thread count.
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!hit[k]) {
+      ++s.no_impacts;
+      continue;
+    }
+    s.eps.push_back(eps[k]), s.omega_x_after.push_back(wx[k]), s.eps_n.push_back(en[k]);
+    s.eps_core.push_back(s.core[k]);
+  }
+  s.seconds_impact = since(t0);
+}
+
+}  // namespace
+
+ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& progress) {
+  validate(c);
+  if (c.threads > 0) omp_set_num_threads(c.threads);
+  ContactSamples s;
+  s.mode = c.mode;
+  resize(s, c.drops);
+  const double R = c.sphere.radius, a = c.sphere.asperity_radius;
+  const std::uint64_t n = c.sphere.asperities;
+
+  if (c.mode == Mode::fresh) {
+    s.batches = c.drops;
+    const auto t0 = Clock::now();
+    for_chunks(c.drops, 0, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
+      const Rotation identity = Rotation::Identity();  // a fresh random sphere needs no rotation
+      const Vec3 down(0, 0, -1);
+      for (std::uint64_t i = b; i < e; ++i) {
+        const auto cap = fresh_cap(n, i, c.seed);
+        const Nearest nn = brute_lowest(cap, down);
+        store(s, i, make_contact(nn, cap[nn.index], identity, R, a));
+      }
+    });
+    s.seconds_query = since(t0);
+  } else {
+    s.batches = c.spheres;
+    const std::uint64_t m = c.drops / c.spheres;
+    // Rotations of sphere k, drops [k m + b, k m + e): the same streams whichever loop runs them.
+    auto rotate = [&](const RoughSphere& body, const ContactQuery& index, std::uint64_t k, std::uint64_t b,
+                      std::uint64_t e) {
+      std::vector<Rotation> q(e - b);
+      std::vector<Vec3> d(e - b);
+      std::vector<Nearest> nn(e - b);
+      for (std::uint64_t j = b; j < e; ++j) {
+        Stream st(c.seed, Purpose::orientation, k * m + j);
+        q[j - b] = random_rotation(st);
+        d[j - b] = body_down(q[j - b]);
+      }
+      index.lowest(d, nn);
+      for (std::uint64_t j = b; j < e; ++j) {
+        const Nearest& r = nn[j - b];
+        store(s, k * m + j, make_contact(r, body.centres[r.index], q[j - b], R, a));
+      }
+    };
+    if (m >= kChunk || c.spheres == 1) {
+      // Few large batches: one sphere at a time, its rotations in parallel.
+      for (std::uint64_t k = 0; k < c.spheres; ++k) {
+        auto t0 = Clock::now();
+        const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
+        s.seconds_generate += since(t0);
+        t0 = Clock::now();
+        const auto index = make_contact_query(c.backend, body.centres);
+        s.seconds_index += since(t0);
+        s.index_bytes = index->memory_bytes();
+        t0 = Clock::now();
+        for_chunks(m, k * m, c.drops, progress,
+                   [&](std::uint64_t b, std::uint64_t e) { rotate(body, *index, k, b, e); });
+        s.seconds_query += since(t0);
+      }
+    } else {
+      // Many small spheres: spheres in parallel, each built and queried by one thread (no
+      // parallel region per sphere). Stage times are then summed over threads.
+      const auto t0 = Clock::now();
+      const std::int64_t spheres = static_cast<std::int64_t>(c.spheres);
+      std::atomic<std::uint64_t> done{0};
+      double gen = 0, idx = 0;
+      std::size_t bytes = 0;
+#pragma omp parallel for schedule(dynamic, 4) reduction(+ : gen, idx) reduction(max : bytes)
+      for (std::int64_t kk = 0; kk < spheres; ++kk) {
+        const auto k = static_cast<std::uint64_t>(kk);
+        auto t = Clock::now();
+        const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
+        gen += since(t);
+        t = Clock::now();
+        const auto index = make_contact_query(c.backend, body.centres);
+        idx += since(t);
+        bytes = std::max(bytes, index->memory_bytes());
+        rotate(body, *index, k, 0, m);
+        const std::uint64_t now = done.fetch_add(m) + m;
+        if (progress && omp_get_thread_num() == 0) progress(now, c.drops);
+      }
+      s.seconds_generate = gen, s.seconds_index = idx, s.index_bytes = bytes;
+      s.seconds_query = since(t0);  // wall time of the whole loop, generation and indexing included
+    }
+  }
+  s.core_contacts = static_cast<std::uint64_t>(std::count(s.core.begin(), s.core.end(), std::uint8_t{1}));
+  if (c.impact.enabled) run_impacts(c, s);
+  return s;
+}
+
+}  // namespace asperity

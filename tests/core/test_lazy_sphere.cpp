@@ -1,0 +1,113 @@
+// The lazy exact sphere: same centres and same answers as an explicit sphere, exactly N centres,
+// uniform, and an exact binomial sampler.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "asperity/core/contact.hpp"
+#include "asperity/core/lazy_sphere.hpp"
+#include "asperity/core/orientation.hpp"
+#include "asperity/core/random.hpp"
+#include "asperity/laws/statistics.hpp"
+
+using namespace asperity;
+
+TEST(LazySphere, CountIsExactlyN) {
+  for (std::uint64_t n : {1ull, 2ull, 7ull, 8ull, 9ull, 513ull, 10007ull, 100000ull}) {
+    LazySphere s(n, 3, 1);
+    const auto c = s.materialise();
+    EXPECT_EQ(c.size(), n);
+    for (const auto& u : c) ASSERT_NEAR(u.norm(), 1.0, 1e-15);
+  }
+  EXPECT_THROW(LazySphere(0, 1, 1), std::invalid_argument);
+}
+
+TEST(LazySphere, QueriesEqualBruteForceOnTheMaterialisedSphere) {
+  // Random directions, directions at centres (key 0) and exact midpoints of centre pairs
+  // (near-ties), queried on a fresh lazy sphere (cells generated on demand, in query order) and
+  // compared bit for bit with brute_lowest over the same indexed centres.
+  for (std::uint64_t n : {1ull, 5ull, 2000ull, 60000ull}) {
+    LazySphere full(n, 11, 4);
+    const auto centres = full.materialise();
+    LazySphere lazy(n, 11, 4);
+    Stream st(5, Purpose::test, n);
+    std::vector<Vec3> dirs;
+    for (int i = 0; i < 1500; ++i) dirs.push_back(body_down(random_rotation(st)));
+    for (std::size_t i = 0; i < std::min<std::size_t>(n, 200); ++i) dirs.push_back(centres[(i * 7919) % n]);
+    for (int i = 0; i < 200 && n > 1; ++i) {
+      const Vec3 a = centres[(i * 31) % n], b = centres[(i * 31 + 1) % n];
+      if ((a + b).norm() > 1e-3) dirs.push_back((a + b).normalized());
+    }
+    for (const auto& d : dirs) {
+      const auto got = lazy.lowest(d);
+      const auto want = brute_lowest(centres, d);
+      ASSERT_EQ(got.nearest, want) << "N = " << n;
+      ASSERT_EQ(got.u, centres[want.index]);
+    }
+    // Queries only generated part of the big sphere, and what they generated is the same sphere.
+    if (n == 60000) {
+      EXPECT_LT(lazy.centres_generated(), n);
+    }
+    EXPECT_EQ(lazy.materialise(), centres);
+  }
+}
+
+TEST(LazySphere, ResetGivesTheSameOrAnotherSphere) {
+  LazySphere s(1000, 1, 1);
+  const auto a = s.materialise();
+  s.reset(1, 2);
+  const auto b = s.materialise();
+  s.reset(1, 1);
+  EXPECT_EQ(s.materialise(), a);
+  EXPECT_NE(a, b);
+}
+
+TEST(LazySphere, CentresAreUniform) {
+  // KS of z against U(-1,1) and of phi against U(0, 2 pi) at N = 1e5 (alpha = 0.001 each).
+  // Power check: the same test rejects the slightly wrong law F(z) = ((1+z)/2)^1.03.
+  LazySphere s(100000, 2, 0);
+  const auto c = s.materialise();
+  std::vector<double> z, phi;
+  for (const auto& u : c) z.push_back(u.z()), phi.push_back(std::atan2(u.y(), u.x()) + std::numbers::pi);
+  std::sort(z.begin(), z.end());
+  std::sort(phi.begin(), phi.end());
+  const auto kz = ks_one_sample(z, [](double t) { return std::clamp((t + 1) / 2, 0.0, 1.0); });
+  const auto kp = ks_one_sample(phi, [](double t) { return std::clamp(t / (2 * std::numbers::pi), 0.0, 1.0); });
+  EXPECT_GT(kz.p, 1e-3) << kz.D;
+  EXPECT_GT(kp.p, 1e-3) << kp.D;
+  const auto wrong = ks_one_sample(z, [](double t) { return std::pow(std::clamp((t + 1) / 2, 0.0, 1.0), 1.03); });
+  EXPECT_LT(wrong.p, 1e-3);
+}
+
+namespace {
+double binom_cdf(std::uint64_t n, double x) {
+  if (x < 0) return 0;
+  const auto k = std::min<std::uint64_t>(n, static_cast<std::uint64_t>(std::floor(x)));
+  double s = 0;
+  for (std::uint64_t j = 0; j <= k; ++j)
+    s += std::exp(std::lgamma(n + 1.0) - std::lgamma(j + 1.0) - std::lgamma(n - j + 1.0) - n * std::numbers::ln2);
+  return std::min(1.0, s);
+}
+}  // namespace
+
+TEST(LazySphere, BinomialHalfIsExact) {
+  // Pearson chi-square against the exact pmf, 2e5 draws, for the popcount branch (n = 300) and
+  // the inversion branch (n = 5000); both must accept at alpha = 0.001, and the same test must
+  // reject the draws shifted by one (a deliberately wrong law).
+  for (std::uint64_t n : {300ull, 5000ull}) {
+    Stream s(9, Purpose::test, n);
+    std::vector<double> x(200000);
+    for (auto& v : x) v = static_cast<double>(binomial_half(n, s));
+    const double sd = std::sqrt(n / 4.0);
+    const double lo = std::floor(n / 2.0 - 6 * sd) - 0.5, hi = std::floor(n / 2.0 + 6 * sd) + 0.5;
+    const auto h = make_histogram(x, lo, hi, static_cast<std::size_t>(hi - lo));
+    const auto r = chi2_test(h, [n](double t) { return binom_cdf(n, t); });
+    EXPECT_GT(r.p, 1e-3) << "n = " << n << " chi2 = " << r.chi2;
+    for (auto& v : x) v += 1;
+    const auto hw = make_histogram(x, lo, hi, static_cast<std::size_t>(hi - lo));
+    EXPECT_LT(chi2_test(hw, [n](double t) { return binom_cdf(n, t); }).p, 1e-3);
+  }
+}

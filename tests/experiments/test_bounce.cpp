@@ -1,0 +1,205 @@
+// Bounce sequences of Sec. V: free flight and rotation, reproducibility, the physics of the first
+// impact, and validate-geometry --preset fig6 end to end.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "asperity/experiments/bounce.hpp"
+#include "asperity/core/restitution.hpp"
+#include "asperity/laws/theory_impact.hpp"
+
+using namespace asperity;
+
+namespace {
+BounceExperiment small(std::uint64_t sequences) {
+  BounceExperiment b;
+  b.enabled = true;
+  b.sequences = sequences;
+  b.bootstrap = 19;
+  return b;
+}
+const SphereParams kSphere{100000, 3e-3, 5e-7};
+}  // namespace
+
+TEST(Bounce, RotationAdvanceIsExactFreeRotation) {
+  // exp(Omega t) q against RK4 integration of dq/dt = (1/2) (0, Omega) q in 1e5 steps.
+  const Eigen::Quaterniond q0 = Eigen::Quaterniond(0.3, -0.5, 0.2, 0.7).normalized();
+  const Vec3 w(0.7, -1.3, 0.4);
+  const double T = 0.37;
+  const int steps = 100000;
+  const double h = T / steps;
+  Eigen::Vector4d y(q0.w(), q0.x(), q0.y(), q0.z());
+  auto f = [&](const Eigen::Vector4d& v) {
+    const Eigen::Quaterniond q(v(0), v(1), v(2), v(3)), wq(0, w.x(), w.y(), w.z());
+    const Eigen::Quaterniond d = wq * q;
+    return Eigen::Vector4d(0.5 * d.w(), 0.5 * d.x(), 0.5 * d.y(), 0.5 * d.z());
+  };
+  for (int i = 0; i < steps; ++i) {
+    const auto k1 = f(y), k2 = f(y + 0.5 * h * k1), k3 = f(y + 0.5 * h * k2), k4 = f(y + h * k3);
+    y += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  const auto q = advance_rotation(q0, w, T);
+  EXPECT_NEAR(std::abs(q.w() * y(0) + q.x() * y(1) + q.y() * y(2) + q.z() * y(3)), 1.0, 1e-12);
+  // A body vector rotates about Omega at |Omega|: its component along Omega is conserved.
+  const Vec3 b(0.1, 0.9, -0.4);
+  EXPECT_NEAR((q * b).dot(w), (q0 * b).dot(w), 1e-14);
+  EXPECT_EQ(advance_rotation(q0, Vec3::Zero(), T).coeffs(), q0.coeffs());
+  // Deliberately wrong rate (1.001 |Omega|) is told apart by the same comparison.
+  const auto qw = advance_rotation(q0, 1.001 * w, T);
+  EXPECT_LT(std::abs(qw.w() * y(0) + qw.x() * y(1) + qw.y() * y(2) + qw.z() * y(3)), 1.0 - 1e-9);
+}
+
+TEST(Bounce, FlightConservesEnergyAndLandsAtTheContactHeight) {
+  const double g = 9.81;
+  for (double vz : {1.0, 0.3, 0.1}) {
+    for (double dh : {0.0, 3e-9, -3e-9}) {
+      const double h0 = 3.0005e-3, D = h0 + dh;
+      const auto f = ballistic_flight(h0, vz, D, g);
+      EXPECT_NEAR(h0 + vz * f.time - 0.5 * g * f.time * f.time, D, 1e-15);
+      EXPECT_NEAR(0.5 * f.landing_vz * f.landing_vz + g * D, 0.5 * vz * vz + g * h0, 1e-15);
+      EXPECT_NEAR(f.landing_vz, vz - g * f.time, 1e-14);
+      if (dh == 0) {
+        EXPECT_DOUBLE_EQ(f.time, 2 * vz / g);
+      }
+    }
+  }
+}
+
+TEST(Bounce, BitIdenticalForOneAndTwoThreads) {
+  for (auto v : {BounceVariant::paper, BounceVariant::random_orientation, BounceVariant::dynamic}) {
+    const auto b = small(24);
+    const auto a1 = run_bounces(kSphere, b, v, 5, 1);
+    const auto a2 = run_bounces(kSphere, b, v, 5, 2);
+    EXPECT_EQ(a1.eps, a2.eps) << to_string(v);
+    EXPECT_EQ(a1.speed, a2.speed);
+    EXPECT_EQ(a1.sequence, a2.sequence);
+    EXPECT_EQ(a1.cells, a2.cells);
+    for (std::size_t i = 0; i < a1.eps_time.size(); ++i)
+      ASSERT_TRUE(a1.eps_time[i] == a2.eps_time[i] || (std::isnan(a1.eps_time[i]) && std::isnan(a2.eps_time[i])));
+    const auto r1 = analyse_bounces(a1, b, 5);
+    omp_set_num_threads(1);
+    const auto r2 = analyse_bounces(a2, b, 5);
+    omp_set_num_threads(2);
+    for (std::size_t g = 0; g < r1.groups.size(); ++g) EXPECT_EQ(r1.groups[g].gof.p, r2.groups[g].gof.p);
+  }
+}
+
+TEST(Bounce, SequencesStopBelowTheThresholdAndTimesMatchVelocities) {
+  const auto b = small(30);
+  for (auto v : {BounceVariant::paper, BounceVariant::dynamic}) {
+    const auto s = run_bounces(kSphere, b, v, 2, 0);
+    ASSERT_FALSE(s.eps.empty());
+    EXPECT_EQ(s.no_impacts, 0u);
+    for (std::size_t j = 0; j < s.eps.size(); ++j) {
+      ASSERT_GE(s.speed[j], b.stop_speed);
+      const bool first = s.number[j] == 1;
+      EXPECT_EQ(first, j == 0 || s.sequence[j] != s.sequence[j - 1]);
+      if (first) {
+        EXPECT_EQ(s.speed[j], b.speed);
+        EXPECT_TRUE(std::isnan(s.eps_time[j]));
+        continue;
+      }
+      // Flight conserves energy: u_j^2 = (eps u_{j-1})^2 + 2 g dh, dh the difference of the contact
+      // heights (paper: 0; explicit: |dh| ~ r_xy^2/(2R) ~ 2R/N = 6e-8 m, bound 20x that).
+      const double up = s.eps[j - 1] * s.speed[j - 1];
+      const double dh = (s.speed[j] * s.speed[j] - up * up) / (2 * b.gravity);
+      EXPECT_LT(std::abs(dh), v == BounceVariant::paper ? 1e-15 : 20 * 2 * kSphere.radius / kSphere.asperities);
+      // eps from flight times equals eps from velocities up to the same height differences: each
+      // flight time T = 2 v/g is off by ~dh/v, so eps(times) by ~ g dh / v^2 (v ~ u_j).
+      const double hmax = 20 * 2 * kSphere.radius / kSphere.asperities;
+      EXPECT_NEAR(s.eps_time[j], s.eps[j], v == BounceVariant::paper ? 1e-14 : 2 * b.gravity * hmax / (s.speed[j] * s.speed[j]));
+    }
+    const bool last_ok = s.eps.back() * s.speed.back() < b.stop_speed * (1 + 1e-6);
+    EXPECT_TRUE(last_ok);
+  }
+}
+
+TEST(Bounce, FirstImpactIsOneSidedWithThePredictedDeficit) {
+  // At Omega = 0: eps = eps_n(u) - alpha W, W/sigma^2 ~ chi2_2, so eps <= eps_n(u) and the mean
+  // deficit is 2 alpha sigma^2 (Sec. IV corrected, theory_impact.hpp). 10^4 dynamic sequences of
+  // N = 1e5 (se ~ 1% of the deficit): the mean deficit must agree within 4 se; a deficit 10% off
+  // is rejected by the same criterion.
+  const auto b = small(10000);
+  auto bb = b;
+  bb.stop_speed = 0.9;  // only the first impacts are needed
+  const auto s = run_bounces(kSphere, bb, BounceVariant::dynamic, 3, 0);
+  ImpactScene sc;
+  sc.asperities = kSphere.asperities, sc.radius = kSphere.radius, sc.asperity_radius = kSphere.asperity_radius;
+  sc.speed = 1.0, sc.omega_x = 0, sc.beta = b.beta;
+  const auto p = impact_law_parameters(sc);
+  double sum = 0, sum2 = 0;
+  std::size_t n = 0;
+  for (std::size_t j = 0; j < s.eps.size(); ++j) {
+    if (s.number[j] != 1 || s.core[j]) continue;
+    const double d = p.eps_n - s.eps[j];
+    ASSERT_GE(d, -1e-12);  // one-sided
+    sum += d, sum2 += d * d, ++n;
+  }
+  const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / n);
+  const double want = 2 * p.alpha * p.sigma * p.sigma;
+  EXPECT_LT(std::abs(mean - want), 4 * se) << mean << " vs " << want;
+  EXPECT_GT(std::abs(mean - 1.1 * want), 4 * se);
+}
+
+TEST(Bounce, ValidationNamesTheField) {
+  auto b = small(10);
+  b.stop_speed = 2;
+  EXPECT_THROW(validate(b), std::invalid_argument);
+  b = small(10);
+  b.windows = {{0.5, 0.4}};
+  EXPECT_THROW(validate(b), std::invalid_argument);
+  b = small(10);
+  b.variants.clear();
+  EXPECT_THROW(validate(b), std::invalid_argument);
+  EXPECT_THROW(parse_bounce_variant("dynamics"), std::invalid_argument);
+  EXPECT_EQ(parse_bounce_variant("random-orientation"), BounceVariant::random_orientation);
+}
+
+#ifdef VALIDATE_GEOMETRY
+namespace {
+int run(const std::string& args) {
+  const int st = std::system((std::string(VALIDATE_GEOMETRY) + " " + args + " >/dev/null 2>&1").c_str());
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+}  // namespace
+
+TEST(Bounce, Fig6CliWritesAWellFormedReport) {
+  const auto dir = std::filesystem::temp_directory_path() / "asperity-test-fig6";
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(run("--preset fig6 --sequences 40 --asperities 1e5 --no-plots --quiet --out " + dir.string()), 0);
+  std::ifstream f(dir / "report.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["schema_version"], 1);
+  EXPECT_EQ(j["scene"], "fig6+custom");
+  const auto& v = j["bounce"]["variants"];
+  ASSERT_EQ(v.size(), 3u);
+  EXPECT_EQ(v[2]["name"], "dynamic");
+  EXPECT_EQ(v[0]["sequences"], 40);
+  bool some_fit = false;
+  for (const auto& g : v[2]["groups"]) {
+    EXPECT_TRUE(g["by"] == "speed" || g["by"] == "impact");
+    if (!g["fit"].is_null()) {
+      some_fit = true;
+      EXPECT_GT(g["fit"]["a"].get<double>(), 0);
+      EXPECT_GT(g["fit"]["m_se"].get<double>(), 0);
+      EXPECT_GE(g["ks"]["p"].get<double>(), 0);
+    }
+  }
+  EXPECT_TRUE(some_fit);
+  EXPECT_TRUE(j["bounce"]["grouping_note"].is_string());
+  // Bad input: exit 2, no report.
+  const auto bad = dir / "bad";
+  EXPECT_EQ(run("--preset fig6 --variant dynamics --out " + bad.string()), 2);
+  EXPECT_EQ(run("--preset fig6 --sequences 0 --out " + bad.string()), 2);
+  EXPECT_EQ(run("--preset fig3 --sequences 10 --out " + bad.string()), 2);
+  EXPECT_FALSE(std::filesystem::exists(bad / "report.json"));
+  std::filesystem::remove_all(dir);
+}
+#endif

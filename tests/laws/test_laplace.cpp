@@ -1,0 +1,148 @@
+// The asymmetric Laplace law (paper Eq. 2) and its maximum-likelihood fit.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "asperity/laws/laplace.hpp"
+#include "asperity/core/random.hpp"
+
+using namespace asperity;
+
+namespace {
+std::vector<double> draw(const AsymmetricLaplace& law, std::size_t n, std::uint64_t index) {
+  Stream s(7, Purpose::test, index);
+  std::vector<double> x(n);
+  for (auto& v : x) v = law.sample(s);
+  return x;
+}
+AsymmetricLaplace truth() { return {0.9, std::log(3e5), std::log(1e6)}; }  // the scale of eps here
+}  // namespace
+
+TEST(Laplace, NormalisedContinuousAndNoUnderflow) {
+  // Rates of 1e7 at m = 0.9: the paper's amplitude b = h e^{-a m} would be e^{-9e6} = 0.
+  const AsymmetricLaplace law{0.9, std::log(1e7), std::log(2e7)};
+  const double h = 1e7 * 2e7 / 3e7;
+  EXPECT_NEAR(law.pdf(0.9) / h, 1.0, 1e-12);
+  EXPECT_NEAR(law.pdf(0.9 - 1e-9) / h, 1.0, 1e-1);  // continuous at the mode
+  EXPECT_TRUE(std::isfinite(law.log_pdf(0.8)));
+  EXPECT_NEAR(law.cdf(0.9), 2e7 / 3e7 * 1.0 - 0.0 + 0.0, 1e-12);  // mass left of m = c/(a+c)
+  // Quantile inverts cdf, and a trapezoid integral of the pdf is 1.
+  for (double p : {1e-6, 0.1, 0.5, 0.66, 0.9, 1 - 1e-9}) EXPECT_NEAR(law.cdf(law.quantile(p)), p, 1e-9);
+  double sum = 0;
+  const double lo = law.quantile(1e-12), hi = law.quantile(1 - 1e-12);
+  const int K = 200000;
+  for (int i = 0; i < K; ++i) {
+    const double t0 = lo + (hi - lo) * i / K, t1 = lo + (hi - lo) * (i + 1) / K;
+    sum += 0.5 * (law.pdf(t0) + law.pdf(t1)) * (t1 - t0);
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-4);
+}
+
+TEST(Laplace, FitRecoversParametersWithinStatedErrors) {
+  // n = 2e4 draws of the law at the scale of eps (rates 3e5 and 1e6 around 0.9): each estimate
+  // within 4 of its Fisher standard errors, and the se close to the asymptotic formula.
+  const auto law = truth();
+  const auto x = draw(law, 20000, 1);
+  const auto f = fit_asymmetric_laplace(x);
+  EXPECT_LT(std::abs(f.m.value - law.m), 4 * f.m.se);
+  EXPECT_LT(std::abs(f.log_a.value - law.log_a), 4 * f.log_a.se);
+  EXPECT_LT(std::abs(f.log_c.value - law.log_c), 4 * f.log_c.se);
+  EXPECT_GT(f.log_a.se, 0.005);
+  EXPECT_LT(f.log_a.se, 0.05);
+  EXPECT_NEAR(f.a.se / f.a.value, f.log_a.se, 1e-15);
+}
+
+TEST(Laplace, ConfidenceIntervalsCover) {
+  // 400 fits of n = 1000: the fraction of +-1.96 se intervals containing the truth must be
+  // 0.95 +- 3 binomial sd (sd = 0.011). A wrong se (e.g. half) would give ~0.68 and fail.
+  const auto law = truth();
+  const int reps = 400;
+  int cov_m = 0, cov_a = 0, cov_c = 0;
+  for (int r = 0; r < reps; ++r) {
+    const auto f = fit_asymmetric_laplace(draw(law, 1000, 100 + r));
+    cov_m += std::abs(f.m.value - law.m) < 1.96 * f.m.se;
+    cov_a += std::abs(f.log_a.value - law.log_a) < 1.96 * f.log_a.se;
+    cov_c += std::abs(f.log_c.value - law.log_c) < 1.96 * f.log_c.se;
+  }
+  for (int c : {cov_m, cov_a, cov_c}) {
+    EXPECT_GT(c / double(reps), 0.95 - 0.033) << c;
+    EXPECT_LT(c / double(reps), 0.95 + 0.033) << c;
+  }
+}
+
+TEST(Laplace, ProfileLikelihoodIsTheMaximum) {
+  // The closed-form profile beats nearby parameter values and every other data point as mode.
+  const auto x = draw(truth(), 500, 3);
+  const auto f = fit_asymmetric_laplace(x);
+  auto ll = [&](const AsymmetricLaplace& l) {
+    double s = 0;
+    for (double v : x) s += l.log_pdf(v);
+    return s;
+  };
+  EXPECT_NEAR(ll(f.law), f.log_likelihood, 1e-6 * std::abs(f.log_likelihood));
+  for (double d : {-0.01, 0.01}) {
+    auto l = f.law;
+    l.log_a += d;
+    EXPECT_LT(ll(l), f.log_likelihood);
+    l = f.law;
+    l.log_c += d;
+    EXPECT_LT(ll(l), f.log_likelihood);
+  }
+  std::vector<double> s = x;
+  std::sort(s.begin(), s.end());
+  for (std::size_t j = 1; j + 1 < s.size(); j += 7) {
+    std::vector<double> one(1, s[j]);
+    // Best rates for mode s[j] (closed form) never beat the fit.
+    double L = 0, R = 0;
+    for (double v : s) (v < s[j] ? L : R) += std::abs(v - s[j]);
+    const double n = double(s.size()), q = std::sqrt(L * R);
+    const AsymmetricLaplace l{s[j], std::log(n / (L + q)), std::log(n / (R + q))};
+    EXPECT_LE(ll(l), f.log_likelihood + 1e-9 * std::abs(f.log_likelihood));
+  }
+}
+
+TEST(Laplace, GoodnessOfFitAcceptsLaplaceAndRejectsOthers) {
+  // Parametric bootstrap, B = 99, n = 2000. The ALD sample is accepted; a Gaussian and a
+  // uniform sample of the same scale are rejected at the smallest attainable p (1/(B+1)).
+  const auto law = truth();
+  auto x = draw(law, 2000, 4);
+  std::sort(x.begin(), x.end());
+  const auto g = laplace_gof(x, fit_asymmetric_laplace_sorted(x), 99, 1, 0);
+  EXPECT_GT(g.p, 0.05);
+  Stream s(8, Purpose::test, 0);
+  std::vector<double> gauss(2000), unif(2000);
+  for (std::size_t i = 0; i < gauss.size(); ++i) {
+    const double u = s.uniform(), v = s.uniform0();
+    gauss[i] = 0.9 + 3e-6 * std::sqrt(-2 * std::log(u)) * std::cos(2 * M_PI * v);
+    unif[i] = 0.9 + 1e-5 * s.uniform0();
+  }
+  for (auto* y : {&gauss, &unif}) {
+    std::sort(y->begin(), y->end());
+    const auto gy = laplace_gof(*y, fit_asymmetric_laplace_sorted(*y), 99, 1, 1);
+    EXPECT_LE(gy.p, 0.02) << gy.D;
+  }
+}
+
+TEST(Laplace, BootstrapIndependentOfThreads) {
+  auto x = draw(truth(), 3000, 5);
+  std::sort(x.begin(), x.end());
+  const auto f = fit_asymmetric_laplace_sorted(x);
+  omp_set_num_threads(1);
+  const auto g1 = laplace_gof(x, f, 40, 3, 9);
+  omp_set_num_threads(2);
+  const auto g2 = laplace_gof(x, f, 40, 3, 9);
+  EXPECT_EQ(g1.D, g2.D);
+  EXPECT_EQ(g1.p, g2.p);
+}
+
+TEST(Laplace, BadInputNamesTheProblem) {
+  EXPECT_THROW(fit_asymmetric_laplace(std::vector<double>{1, 2}), std::invalid_argument);
+  EXPECT_THROW(fit_asymmetric_laplace(std::vector<double>{1, 1, 1, 1}), std::invalid_argument);
+  EXPECT_THROW(fit_asymmetric_laplace(std::vector<double>{1, NAN, 2, 3}), std::invalid_argument);
+  EXPECT_THROW(fit_asymmetric_laplace_sorted(std::vector<double>{3, 2, 1}), std::invalid_argument);
+  EXPECT_THROW(truth().quantile(1.0), std::invalid_argument);
+}
