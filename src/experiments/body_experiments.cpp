@@ -47,11 +47,11 @@ LawCheck ks_check(const std::string& quantity, const std::vector<double>& sorted
   } catch (const std::exception& ex) {  // a law that cannot be evaluated here: listed, not dropped
     c.ks.D = c.ks.p = kNaN;
     c.ks.n = sorted.size();
-    c.verdict = "skipped";
+    c.verdict = Verdict::skipped;
     c.note += std::string(c.note.empty() ? "" : "; ") + "not tested: cannot be evaluated at these parameters: " + ex.what();
     return c;
   }
-  c.verdict = c.ks.p < alpha ? "reject" : "accept";
+  c.verdict = verdict_at(c.ks.p, alpha);
   return c;
 }
 
@@ -104,12 +104,12 @@ struct ScreeningPool {
 
 bool decisive_rejection(const std::vector<LawCheck>& tests) {
   for (const auto& t : tests)
-    if (t.decisive && t.verdict == "reject") return true;
+    if (t.decisive && t.verdict == Verdict::reject) return true;
   return false;
 }
 std::size_t decisive_skipped(const std::vector<LawCheck>& tests) {
   return static_cast<std::size_t>(
-      std::count_if(tests.begin(), tests.end(), [](const LawCheck& t) { return t.decisive && t.verdict == "skipped"; }));
+      std::count_if(tests.begin(), tests.end(), [](const LawCheck& t) { return t.decisive && t.verdict == Verdict::skipped; }));
 }
 bool RadiiReport::rejected() const { return decisive_rejection(tests); }
 
@@ -516,7 +516,7 @@ std::vector<Law> eps_tests(const MeshImpactExperiment& e, const MeshDrops& D, co
       c.law = q == std::string("eps") ? "eq28-corrected" : "eq33-corrected";
       c.lambda = c.ks.D = c.ks.p = kNaN;
       c.ks.n = D.e_ok.size();
-      c.verdict = "skipped";
+      c.verdict = Verdict::skipped;
       c.note = std::string("not tested: cannot be evaluated at these parameters: ") + ex.what();
       r.tests.push_back(c);
     }
