@@ -146,19 +146,64 @@ void tally(ScreeningResult& r, const std::vector<std::uint32_t>& ncomp) {
 
 }  // namespace
 
+namespace {
+
+// Competitors of asperity j on a sphere: the centres within L R whose half-space is not satisfied
+// everywhere in the cap region {|x| <= 1, u_j.x >= c} where j can win.
+std::vector<HalfSpace> cap_competitors(const RoughBody& b, const SupportQuery& q, const std::vector<Vec3>& u,
+                                       const std::vector<double>& sr, std::uint32_t j, double c, double S, double L) {
+  const Vec3& uj = u[j];
+  std::vector<HalfSpace> comp;
+  for (std::uint32_t i : q.within(b.centres[j], L * b.base_radius)) {
+    if (i == j) continue;
+    const Vec3 a = uj - u[i];
+    const double beta = sr[i] - sr[j];
+    if (c > 0) {
+      // min over the cap region of a.x, on its rim.
+      const double au = a.dot(uj);
+      const double perp = std::sqrt(std::max(0.0, a.squaredNorm() - au * au));
+      if (c * au - S * perp - beta > 1e-13) continue;  // satisfied everywhere in the region
+    }
+    comp.push_back({a, beta});
+  }
+  return comp;
+}
+
+// Witness search: over-relaxed projections onto the most violated constraint, on the sphere; true
+// if a direction where j wins is found (confirmed by the exact support query).
+bool cap_witness(const RoughBody& b, const SupportQuery& q, const std::vector<HalfSpace>& comp, std::uint32_t j,
+                 const Vec3& uj, double c) {
+  Vec3 d = uj;
+  for (int it = 0; it < 200; ++it) {
+    double worst = 0;
+    const HalfSpace* w = nullptr;
+    for (const HalfSpace& h : comp) {
+      const double v = h.n.dot(d) - h.beta;
+      if (v < worst) worst = v, w = &h;
+    }
+    if (!w) return support_value(b.centres[j], b.radii[j], d) >= q.support(d).h;
+    d += 1.5 * (-worst / w->n.squaredNorm()) * w->n;
+    d.normalize();
+    if (d.dot(uj) < c) return false;  // left the region where j can win
+  }
+  return false;
+}
+
+}  // namespace
+
 ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
   const auto t0 = std::chrono::steady_clock::now();
   const double R = b.base_radius;
   if (!(R > 0)) throw std::invalid_argument("screen_sphere: body '" + b.name + "' is not a rough sphere (base radius 0)");
   const std::size_t n = b.size();
   std::vector<Vec3> u(n);
-  std::vector<double> s(n);
+  std::vector<double> sr(n);
   double s_min = std::numeric_limits<double>::infinity(), s_max = 0;
   for (std::size_t i = 0; i < n; ++i) {
     u[i] = b.centres[i] / R;
-    s[i] = b.radii[i] / R;
-    s_min = std::min(s_min, s[i]);
-    s_max = std::max(s_max, s[i]);
+    sr[i] = b.radii[i] / R;
+    s_min = std::min(s_min, sr[i]);
+    s_max = std::max(s_max, sr[i]);
   }
   const double ccov = cos_cover(u);
   // Padded: the region bound must never be too small.
@@ -178,50 +223,20 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
     const Vec3& uj = u[j];
     // j can only win at d with 1 - u_j.d <= delta_cov + s_j - s_min (the nearest centre to d is
     // within the largest empty cap, and it has s >= s_min).
-    const double delta = (delta_cov + (s[j] - s_min)) * (1 + 1e-9) + 1e-15;
+    const double delta = (delta_cov + (sr[j] - s_min)) * (1 + 1e-9) + 1e-15;
     const double c = 1.0 - delta;
     const double S = c > 0 ? std::sqrt(std::max(0.0, 1.0 - c * c)) : 1.0;
-    const double bmax = s_max - s[j];
+    const double bmax = s_max - sr[j];
     double L = c > 0 ? (S + std::sqrt(S * S + 2.0 * c * bmax)) / c : 2.1;
     L = std::min(2.1, L * (1 + 1e-9) + 1e-12);
-    std::vector<HalfSpace> comp;
-    for (std::uint32_t i : q.within(b.centres[j], L * R)) {
-      if (i == j) continue;
-      const Vec3 a = uj - u[i];
-      const double beta = s[i] - s[j];
-      if (c > 0) {
-        // min over the cap region {|x| <= 1, u_j.x >= c} of a.x, on its rim.
-        const double au = a.dot(uj);
-        const double perp = std::sqrt(std::max(0.0, a.squaredNorm() - au * au));
-        if (c * au - S * perp - beta > 1e-13) continue;  // satisfied everywhere in the region
-      }
-      comp.push_back({a, beta});
-    }
+    std::vector<HalfSpace> comp = cap_competitors(b, q, u, sr, j, c, S, L);
     ncomp[j] = static_cast<std::uint32_t>(comp.size());
     // Most threatening (most violated at d = u_j) first: certificates of screening come early.
     std::sort(comp.begin(), comp.end(), [&](const HalfSpace& x, const HalfSpace& y) {
       return x.beta - x.n.dot(uj) > y.beta - y.n.dot(uj);
     });
 
-    // Witness search: over-relaxed projections onto the most violated constraint, on the sphere.
-    Vec3 d = uj;
-    bool won = false;
-    for (int it = 0; it < 200; ++it) {
-      double worst = 0;
-      const HalfSpace* w = nullptr;
-      for (const HalfSpace& h : comp) {
-        const double v = h.n.dot(d) - h.beta;
-        if (v < worst) worst = v, w = &h;
-      }
-      if (!w) {
-        const Support sp = q.support(d);
-        won = support_value(b.centres[j], b.radii[j], d) >= sp.h;
-        break;
-      }
-      d += 1.5 * (-worst / w->n.squaredNorm()) * w->n;
-      d.normalize();
-      if (d.dot(uj) < c) break;  // left the region where j can win
-    }
+    const bool won = cap_witness(b, q, comp, j, uj, c);
     if (won) {
       r.status[j] = Screen::witness;
       continue;

@@ -204,7 +204,9 @@ State step(const State& x, double h, Phase ph, const Mat3& C, const Vec2& tau, c
   return y;
 }
 
-// The impulse process of Coulomb friction with a normal restitution rule.
+// The impulse process of Coulomb friction with a normal restitution rule. A numerical kernel kept
+// in one piece on purpose: its phases (slip, stick, resumed; compression, restitution) share the
+// integrator state and step control, and splitting it would scatter that state over many calls.
 ImpactProcess coulomb_process(const RigidBody& body, const ImpactState& s, double e, const TangentialLaw& law) {
   const Contact c = contact_frame(body, s);
   const double mu = law.mu;
