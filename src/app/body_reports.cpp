@@ -111,6 +111,8 @@ std::string format_table(const MeshImpactReport& r) {
   os << "comparison sphere: R = " << r.law_radius << " m, N = " << r.law_asperities << " (same areal density)\n";
   os << "drops " << r.samples << ", no impact " << r.no_impacts << ", base surface lower than every asperity "
      << r.core_contacts << "\n";
+  os << "tangential law " << tangential_law(e).describe() << ": impacts gaining kinetic energy " << 100 * r.energy_gain_fraction
+     << " %, largest relative change " << r.energy_gain_max << "\n";
   if (const auto& s = r.screening; s.bodies > 0) {
     os << "screening (" << s.bodies << " bodies): lambda = " << s.lambda << ", lambda_eff = " << s.lambda_eff.value << " +- "
        << s.lambda_eff.se << " 1/m^2, kept fraction " << s.kept_fraction << ", by level:";
@@ -145,6 +147,9 @@ std::string to_json(const MeshImpactReport& r) {
   j["speed"] = e.speed;
   j["omega"] = {e.omega.x(), e.omega.y(), e.omega.z()};
   j["seed"] = e.seed;
+  j["tangential"] = tangential_law(e).describe();
+  j["energy_gain_fraction"] = r.energy_gain_fraction;
+  j["energy_gain_max"] = r.energy_gain_max;
   j["mass"] = {{"mass", r.mass.mass},
                {"volume", r.mass.volume},
                {"area", r.mass.area},

@@ -255,6 +255,9 @@ std::string format_table(const MeshBounceReport& r) {
      << e.asperities << ", radii " << e.radii.describe() << ", " << e.bodies << " bodies\n";
   os << "mass " << r.mass << " kg, principal moments " << r.principal_moments.transpose() << " kg m^2, max |c_i| " << r.c_max
      << " m\n";
+  TangentialLaw law = e.options.tangential;
+  if (law.model == TangentialLaw::Model::kinematic) law.eps_t = e.options.bounce.eps_t;
+  os << "tangential law " << law.describe() << "\n";
   os << "first impact u = " << e.options.bounce.speed << " m/s, Omega = " << e.options.bounce.omega.transpose() << " rad/s, stop below "
      << e.options.bounce.stop_speed << " m/s, g = " << e.options.bounce.gravity << " m/s^2\n";
   os << b.base.sequences << " sequences, " << b.base.impacts << " impacts: " << b.base.impacts_per_sequence << " +- "
@@ -294,6 +297,9 @@ std::string to_json(const MeshBounceReport& r) {
   nlohmann::json j = nlohmann::json::parse(bounce_to_json("", none, e.options.bounce, e.seed, {b.base}, r.plots));
   j.erase("scene");  // the header's (with_header, report.hpp)
   j["mode"] = "body-bounce";
+  TangentialLaw law = e.options.tangential;
+  if (law.model == TangentialLaw::Model::kinematic) law.eps_t = e.options.bounce.eps_t;
+  j["tangential"] = law.describe();
   j["parameters"] = {{"asperities", e.asperities}, {"radii", e.radii.describe()}, {"bodies", e.bodies}, {"seed", e.seed}};
   j["body"] = {{"name", r.body_name},
                {"mesh", e.mesh.string()},

@@ -47,6 +47,7 @@ MeshImpactExperiment mesh_experiment(const Scene& s) {
   m.omega = e.impact.omega;
   m.beta = e.impact.beta;
   m.eps_t = e.impact.eps_t;
+  m.tangential = e.impact.tangential;
   m.seed = e.seed;
   m.alpha = s.alpha;
   m.plots = s.plots;
@@ -212,6 +213,7 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
   m.seed = e.seed;
   m.threads = e.threads;
   m.options.bounce = s.bounce;
+  m.options.tangential = e.impact.tangential;
   m.plots = s.plots;
   const std::optional<TriangleMesh> mesh =
       m.mesh.empty() ? std::nullopt : std::optional<TriangleMesh>(read_mesh(m.mesh, m.scale));

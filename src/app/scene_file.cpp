@@ -223,6 +223,41 @@ constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ense
 // THE mapping from a scene file to a Scene: every section and key of format 1 is read here, and
 // nowhere else. New engine features (mesh bodies, radius distributions, bounce experiments, ...)
 // are wired in by replacing the matching `unsupported(...)` with a field of Scene.
+// material.tangential = { model = "kinematic" (eps_t) | "coulomb" (mu, restitution = "newton" |
+// "poisson" | "energetic") | "stronge" (mu) | "walton" (mu, beta0) } (core/tangential.hpp).
+TangentialLaw read_tangential(Reader& t) {
+  const auto model = t.choice("model", {"kinematic", "coulomb", "stronge", "walton"});
+  if (!model)
+    t.missing("model", "\"kinematic\" (eps_t), \"coulomb\" (mu, restitution), \"stronge\" (mu) or \"walton\" (mu, beta0)");
+  auto mu = [&] {
+    const auto m = t.real("mu");
+    if (!m) t.missing("mu", "the friction coefficient, e.g. 0.1");
+    if (*m < 0) t.bad("mu", "must be >= 0, got " + num(*m));
+    return *m;
+  };
+  TangentialLaw law;
+  if (*model == "kinematic") {
+    const auto e = t.real("eps_t");
+    if (e && (*e < -1 || *e > 1)) t.bad("eps_t", "must be in [-1, 1], got " + num(*e));
+    law = TangentialLaw::kinematic(e.value_or(1.0));
+  } else if (*model == "coulomb") {
+    const double m = mu();
+    const auto rule = t.choice("restitution", {"newton", "poisson", "energetic"});
+    if (!rule) t.missing("restitution", "\"newton\", \"poisson\" or \"energetic\" (Stronge)");
+    law = TangentialLaw::coulomb(m, parse_normal_rule(*rule));
+  } else if (*model == "stronge") {
+    law = TangentialLaw::stronge(mu());
+  } else {
+    const double m = mu();
+    const auto b = t.real("beta0");
+    if (!b) t.missing("beta0", "tangential restitution when sticking, in [-1, 1]");
+    if (*b < -1 || *b > 1) t.bad("beta0", "must be in [-1, 1], got " + num(*b));
+    law = TangentialLaw::walton(m, *b);
+  }
+  t.finish();
+  return law;
+}
+
 Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   Reader top(root, "", origin);
   Scene s;
@@ -265,9 +300,23 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   auto& impact = s.ensemble.impact;
   if (auto mat = top.table("material")) {
     if (auto d = mat->positive("density", "kg/m^3")) impact.density = *d;
+    const bool eps_t_given = mat->has("eps_t");
     if (auto e = mat->real("eps_t")) {
       if (*e < -1 || *e > 1) mat->bad("eps_t", "must be in [-1, 1], got " + num(*e));
       impact.eps_t = *e;
+    }
+    if (auto tan = mat->table("tangential")) {
+      impact.tangential = read_tangential(*tan);
+      if (impact.tangential.model != TangentialLaw::Model::kinematic) {
+        if (eps_t_given) mat->bad("eps_t", "belongs to the kinematic law; material.tangential chose " + impact.tangential.describe());
+        if (!s.mesh)
+          tan->bad("model", "laws other than \"kinematic\" apply to mesh bodies (body.kind = \"mesh\") in this release, got \"" +
+                            std::string(to_string(impact.tangential.model)) + "\"");
+      } else if (eps_t_given) {
+        mat->bad("eps_t", "give it once: tangential = { model = \"kinematic\", eps_t = ... } or eps_t, not both");
+      } else {
+        impact.eps_t = impact.tangential.eps_t;
+      }
     }
     if (auto rest = mat->table("restitution")) {
       const auto model = rest->choice("model", {"viscoelastic", "constant"});
@@ -689,8 +738,14 @@ std::string to_toml(const Scene& s) {
   } else {
     os << "[body]\nkind = \"sphere\"\nradius = " << num(e.sphere.radius) << "\n\n";
   }
-  os << "[material]\ndensity = " << num(x.density) << "\neps_t = " << num(x.eps_t)
-     << "\nrestitution = { model = \"viscoelastic\", beta = " << num(x.beta) << " }\n\n";
+  os << "[material]\ndensity = " << num(x.density);
+  if (const auto& t = x.tangential; t.model == TangentialLaw::Model::coulomb)
+    os << "\ntangential = { model = \"coulomb\", mu = " << num(t.mu) << ", restitution = \"" << to_string(t.normal) << "\" }";
+  else if (t.model == TangentialLaw::Model::walton)
+    os << "\ntangential = { model = \"walton\", mu = " << num(t.mu) << ", beta0 = " << num(t.beta0) << " }";
+  else
+    os << "\neps_t = " << num(x.eps_t);
+  os << "\nrestitution = { model = \"viscoelastic\", beta = " << num(x.beta) << " }\n\n";
   os << "[asperities]\ncount = " << e.sphere.asperities << "\n";
   if (!s.radii) {
     os << "radius = { distribution = \"fixed\", value = " << num(e.sphere.asperity_radius) << " }\n\n";

@@ -94,6 +94,7 @@ Landing next_landing(const RoughBody& b, const BodyBounds& bb, const SupportQuer
 
 void validate(const BodyBounceOptions& o) {
   validate(o.bounce);
+  validate(o.tangential);
   if (o.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
     throw std::invalid_argument("bounce: variants must be \"dynamic\" for a body (orientation carried by the free rotation), got " +
                                 std::to_string(o.bounce.variants.size()) + " variant(s) starting with " +
@@ -131,6 +132,8 @@ void run_sequence(std::uint64_t s, const RoughBody& b, const BodyBounds& bb, con
   Stream st(seed, Purpose::bounce, s, kBodyBounceSub);
   Rotation q = random_rotation(st);
   Vec3 V(0, 0, -o.bounce.speed), W = o.bounce.omega;
+  TangentialLaw law = o.tangential;
+  if (law.model == TangentialLaw::Model::kinematic) law.eps_t = o.bounce.eps_t;
   double z = index.support(body_down(q)).h;  // touching at t = 0
   out.e0 = body_energy(b, q, V, W, z, g);
   double T_prev = kNaN, time = 0;
@@ -140,7 +143,7 @@ void run_sequence(std::uint64_t s, const RoughBody& b, const BodyBounds& bb, con
     // eps = -V'_z/V_z (Eq. 1) is undefined at V_z = 0 exactly (solve_impact refuses it): counted as
     // no approach rather than thrown inside the parallel loop. Never seen; V_z = v0 - g t.
     if (V.z() == 0) { out.stop = Stop::no_approach; return; }
-    const BodyImpact bi = body_impact(b, index, q, V, W, eps_n, o.bounce.eps_t);
+    const BodyImpact bi = body_impact(b, index, q, V, W, eps_n, law);
     if (!bi.result) { out.stop = Stop::no_approach; return; }
     const ImpactResult& res = *bi.result;
     if (-res.v_n < o.bounce.stop_speed) { out.stop = Stop::slow; return; }

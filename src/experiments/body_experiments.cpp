@@ -345,6 +345,12 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e, const Progress& progr
 
 namespace asperity {
 
+TangentialLaw tangential_law(const MeshImpactExperiment& e) {
+  TangentialLaw law = e.tangential;
+  if (law.model == TangentialLaw::Model::kinematic) law.eps_t = e.eps_t;
+  return law;
+}
+
 void validate(const MeshImpactExperiment& e) {
   if (!std::isfinite(e.scale) || e.scale <= 0) throw std::invalid_argument("mesh scale must be finite and > 0, got " + num(e.scale));
   if (!e.smooth_ellipsoid.empty() && e.smooth_ellipsoid.size() != 3 && e.smooth_ellipsoid.size() != 4)
@@ -359,6 +365,7 @@ void validate(const MeshImpactExperiment& e) {
   if (!std::isfinite(e.speed) || e.speed <= 0) throw std::invalid_argument("speed must be finite and > 0 m/s, got " + num(e.speed));
   if (!e.omega.allFinite()) throw std::invalid_argument("omega must be finite");
   if (!(e.alpha > 0 && e.alpha < 1)) throw std::invalid_argument("alpha must be in (0,1), got " + num(e.alpha));
+  validate(e.tangential);
   if (e.screen_bodies > 0 && e.screen_directions < 1)
     throw std::invalid_argument("screen_directions must be >= 1 when screen_bodies > 0, got 0");
 }
@@ -367,8 +374,9 @@ namespace {
 
 // Per-drop values of a mesh run (K bodies x M rotations, drop = k*M + j).
 struct MeshDrops {
-  explicit MeshDrops(std::size_t n) : rx(n), ry(n), rz(n), rxy(n), eps(n, kNaN), wx(n, kNaN), core(n, 0), hit(n, 0) {}
+  explicit MeshDrops(std::size_t n) : rx(n), ry(n), rz(n), rxy(n), eps(n, kNaN), wx(n, kNaN), gain(n, kNaN), core(n, 0), hit(n, 0) {}
   std::vector<double> rx, ry, rz, rxy, eps, wx;
+  std::vector<double> gain;  ///< relative change of the kinetic energy in the impact
   std::vector<std::uint8_t> core, hit;
   std::vector<double> e_ok, w_ok;  ///< eps and Omega'_x of the drops that impacted
 };
@@ -429,6 +437,8 @@ void finish_screening(const MeshImpactExperiment& e, const ScreeningPool& pool, 
 // K explicit bodies x M Haar rotations each: contact, impact, and whether the bare base reaches lower.
 MeshDrops drop_bodies(const MeshImpactExperiment& e, const TriangleMesh& mesh, MeshImpactReport& r, const Progress& progress) {
   const auto eps_n = viscoelastic_pade14(e.beta);
+  const TangentialLaw law = tangential_law(e);
+  const Vec3 V0(0, 0, -e.speed);
   const std::uint64_t M = e.drops / e.bodies;
   MeshDrops D(e.drops);
   const bool unequal = unequal_radii(e.radii);
@@ -445,7 +455,7 @@ MeshDrops drop_bodies(const MeshImpactExperiment& e, const TriangleMesh& mesh, M
       const std::uint64_t drop = k * M + j;
       Stream st(e.seed, Purpose::orientation, drop);
       const Rotation rot = random_rotation(st);
-      const BodyImpact bi = body_impact(b, *q, rot, Vec3(0, 0, -e.speed), e.omega, *eps_n, e.eps_t);
+      const BodyImpact bi = body_impact(b, *q, rot, V0, e.omega, *eps_n, law);
       const Vec3& c = bi.contact.r;
       D.rx[drop] = c.x(), D.ry[drop] = c.y(), D.rz[drop] = c.z(), D.rxy[drop] = std::hypot(c.x(), c.y());
       D.core[drop] = -c.z() < base_support(e, mesh, r.mass.centroid, body_down(rot));
@@ -453,14 +463,23 @@ MeshDrops drop_bodies(const MeshImpactExperiment& e, const TriangleMesh& mesh, M
         D.hit[drop] = 1;
         D.eps[drop] = bi.result->eps;
         D.wx[drop] = bi.result->Omega_after.x();
+        const RigidBody rb = world_rigid_body(b, rot);
+        const double E0 = kinetic_energy(rb, V0, e.omega);
+        D.gain[drop] = (kinetic_energy(rb, bi.result->V_after, bi.result->Omega_after) - E0) / E0;
       }
     });
   }
   finish_screening(e, pool, scr);
+  r.energy_gain_max = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < D.hit.size(); ++i) {
     r.no_impacts += !D.hit[i], r.core_contacts += D.core[i];
-    if (D.hit[i]) D.e_ok.push_back(D.eps[i]), D.w_ok.push_back(D.wx[i]);
+    if (!D.hit[i]) continue;
+    D.e_ok.push_back(D.eps[i]), D.w_ok.push_back(D.wx[i]);
+    r.energy_gain_fraction += D.gain[i] > 1e-9;
+    r.energy_gain_max = std::max(r.energy_gain_max, D.gain[i]);
   }
+  if (!D.e_ok.empty()) r.energy_gain_fraction /= static_cast<double>(D.e_ok.size());
+  else r.energy_gain_max = kNaN;
   r.samples = e.drops;
   return D;
 }
@@ -581,7 +600,9 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const TriangleM
   r.tests.push_back(ks_check("r_x", srx, l18, areal_density(r.law_asperities, Rl), e.alpha, false, "Eq. 18, " + pooled));
   r.tests.push_back(ks_check("r_x", srx, eq18_rx(r.law_asperities, Rl, 1.05), kNaN, e.alpha, true, "Eq. 18 stretched by 5%: must be rejected"));
   const ImpactScene sc = comparison_scene(e, r);
-  const bool sec4 = e.eps_t == 1.0 && e.omega.z() == 0.0 && D.e_ok.size() >= 2;
+  // The Sec. IV laws assume the paper's kinematic law with eps_t = 1.
+  const bool sec4 = tangential_law(e).model == TangentialLaw::Model::kinematic && e.eps_t == 1.0 && e.omega.z() == 0.0 &&
+                    D.e_ok.size() >= 2;
   const std::vector<Law> eps_laws = sec4 ? eps_tests(e, D, sc, pooled, r) : std::vector<Law>{};
   r.seconds_analysis = seconds_since(ts);
   ts = std::chrono::steady_clock::now();

@@ -8,6 +8,7 @@
 #include "asperity/core/impact.hpp"
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/support.hpp"
+#include "asperity/core/tangential.hpp"
 
 namespace asperity {
 
@@ -23,5 +24,8 @@ RigidBody world_rigid_body(const RoughBody& b, const Rotation& q);
 /// spin Omega (world frame, SI) on the plate n = +z.
 BodyImpact body_impact(const RoughBody& b, const SupportQuery& index, const Rotation& q, const Vec3& V, const Vec3& Omega,
                        const Restitution& eps_n, double eps_t = 1.0);
+/// The same under any tangential law (core/tangential.hpp).
+BodyImpact body_impact(const RoughBody& b, const SupportQuery& index, const Rotation& q, const Vec3& V, const Vec3& Omega,
+                       const Restitution& eps_n, const TangentialLaw& law);
 
 }  // namespace asperity

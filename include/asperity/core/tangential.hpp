@@ -42,6 +42,8 @@ struct TangentialLaw {
 
   /// "kinematic (eps_t = 1)", "coulomb (mu = 0.1, poisson)", ...
   std::string describe() const;
+
+  friend bool operator==(const TangentialLaw&, const TangentialLaw&) = default;
 };
 
 std::string_view to_string(TangentialLaw::Model m);

@@ -105,6 +105,8 @@ struct BodyBounceOptions {
   /// mass); variants must be {dynamic} (the orientation carried by the free rotation: the only
   /// meaning bounce variants have for a body).
   BounceExperiment bounce;
+  /// The tangential law of every impact (core/tangential.hpp); kinematic uses bounce.eps_t.
+  TangentialLaw tangential;
   double max_time = 60;    ///< total time per sequence [s]
   LandingOptions landing;
 };

@@ -98,7 +98,8 @@ struct MeshImpactExperiment {
   double speed = 1.3;                  ///< [m/s], V = (0, 0, -speed)
   Vec3 omega{0.2, 0.0, 0.0};           ///< [rad/s]
   double beta = 0.0467;                ///< Pade [1/4] constant of eps_n(v)
-  double eps_t = 1.0;
+  double eps_t = 1.0;                  ///< kinematic law's coefficient (tangential.model == kinematic)
+  TangentialLaw tangential;            ///< the tangential law; kinematic uses eps_t above
   std::uint64_t seed = 1;
   double alpha = 0.01;
   bool plots = true;  ///< build the figures (MeshImpactReport::figures)
@@ -106,6 +107,8 @@ struct MeshImpactExperiment {
   std::uint64_t screen_directions = 200000;  ///< random directions of the screening cross-check, per body
 };
 void validate(const MeshImpactExperiment& e);
+/// The law the impacts use: e.tangential, with e.eps_t when it is the kinematic law.
+TangentialLaw tangential_law(const MeshImpactExperiment& e);
 
 struct NamedSummary {
   std::string name;  ///< "r_x", "r_y", "r_z", "r_xy" [m], "eps" [1], "omega_x_after" [rad/s]
@@ -134,6 +137,10 @@ struct MeshImpactReport {
   std::uint64_t law_asperities = 0; ///< N of the comparison sphere (same areal density)
   std::uint64_t samples = 0, no_impacts = 0;
   std::uint64_t core_contacts = 0;  ///< drops where the bare base surface reaches lower than every asperity
+  /// Impacts whose kinetic energy increases (> 1e-9 relative), and the largest relative change
+  /// (negative: every impact lost energy; NaN without impacts): the kinematic law with eps_t = 1
+  /// gains off-centre, Stronge's law never does.
+  double energy_gain_fraction = 0, energy_gain_max = 0;
   std::vector<NamedSummary> quantities;
   std::vector<LawCheck> tests;      ///< pooled over K x M drops: p assumes iid (see note)
   std::vector<NamedFigure> figures;  ///< built when experiment.plots; written by app/

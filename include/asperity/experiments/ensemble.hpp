@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "asperity/core/contact.hpp"
+#include "asperity/core/tangential.hpp"
 #include "asperity/core/geometry.hpp"
 
 namespace asperity {
@@ -36,6 +37,9 @@ struct ImpactExperiment {
   double density = 7850;         ///< [kg/m^3]; mass M = 4/3 pi R^3 density (eps does not depend on it)
   double beta = 0.0467;          ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
   double eps_t = 1.0;            ///< tangential restitution (paper: 1)
+  /// The tangential law (core/tangential.hpp). kinematic (the default) uses eps_t above; coulomb and
+  /// walton apply to mesh-body runs (single impacts and bounces); sphere runs refuse them for now.
+  TangentialLaw tangential;
 
   friend bool operator==(const ImpactExperiment&, const ImpactExperiment&) = default;
 };
