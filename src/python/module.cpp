@@ -110,8 +110,40 @@ py::array_t<double> vectors_to_numpy(const std::vector<Vec3>& v, bool single) {
 
 // ---- scenes: a path, a preset name, or a dict in the scene-file layout ----
 
+// A scalar (bool, int, float, str, numpy scalar) handed to sink; false for anything else.
 template <class Sink>
-void to_toml_value(const py::handle& h, const std::string& key, Sink sink);
+bool toml_scalar(const py::handle& h, Sink sink) {
+  if (py::isinstance<py::bool_>(h)) return sink(h.cast<bool>()), true;
+  if (py::isinstance<py::int_>(h)) return sink(h.cast<std::int64_t>()), true;
+  if (py::isinstance<py::float_>(h)) return sink(h.cast<double>()), true;
+  if (py::isinstance<py::str>(h)) return sink(h.cast<std::string>()), true;
+  if (py::isinstance<py::dict>(h) || py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h))
+    return false;
+  const auto o = py::reinterpret_borrow<py::object>(h);
+  if (py::hasattr(h, "__index__")) return sink(py::int_(o).cast<std::int64_t>()), true;  // numpy integers
+  if (py::hasattr(h, "__float__")) return sink(py::float_(o).cast<double>()), true;      // numpy floats
+  return false;
+}
+
+bool is_sequence(const py::handle& h) {
+  return py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h);
+}
+
+toml::table to_toml_table(const py::dict& d, const std::string& key);
+
+toml::array to_toml_array(const py::handle& h, const std::string& key) {
+  toml::array a;
+  py::list l = py::isinstance<py::array>(h) ? py::list(h.attr("tolist")()) : py::list(py::reinterpret_borrow<py::object>(h));
+  for (std::size_t i = 0; i < l.size(); ++i) {
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    const py::handle v = l[i];
+    if (toml_scalar(v, [&](auto&& x) { a.push_back(std::forward<decltype(x)>(x)); })) continue;
+    if (py::isinstance<py::dict>(v)) a.push_back(to_toml_table(v.cast<py::dict>(), k));
+    else if (is_sequence(v)) a.push_back(to_toml_array(v, k));
+    else value_error("scene dict: " + k + " = " + show(v) + ": not a bool, number, string, list or dict");
+  }
+  return a;
+}
 
 toml::table to_toml_table(const py::dict& d, const std::string& key) {
   toml::table t;
@@ -120,29 +152,12 @@ toml::table to_toml_table(const py::dict& d, const std::string& key) {
     const std::string name = k.cast<std::string>();
     const std::string full = key.empty() ? name : key + "." + name;
     if (v.is_none()) continue;  // None: the key is absent (its default)
-    to_toml_value(v, full, [&](auto&& x) { t.insert(name, std::forward<decltype(x)>(x)); });
+    if (toml_scalar(v, [&](auto&& x) { t.insert(name, std::forward<decltype(x)>(x)); })) continue;
+    if (py::isinstance<py::dict>(v)) t.insert(name, to_toml_table(v.cast<py::dict>(), full));
+    else if (is_sequence(v)) t.insert(name, to_toml_array(v, full));
+    else value_error("scene dict: " + full + " = " + show(v) + ": not a bool, number, string, list or dict");
   }
   return t;
-}
-
-template <class Sink>
-void to_toml_value(const py::handle& h, const std::string& key, Sink sink) {
-  if (py::isinstance<py::bool_>(h)) return sink(h.cast<bool>());
-  if (py::isinstance<py::int_>(h)) return sink(h.cast<std::int64_t>());
-  if (py::isinstance<py::float_>(h)) return sink(h.cast<double>());
-  if (py::isinstance<py::str>(h)) return sink(h.cast<std::string>());
-  if (py::isinstance<py::dict>(h)) return sink(to_toml_table(h.cast<py::dict>(), key));
-  if (py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h)) {
-    toml::array a;
-    py::list l = py::isinstance<py::array>(h) ? py::list(h.attr("tolist")()) : py::list(py::reinterpret_borrow<py::object>(h));
-    for (std::size_t i = 0; i < l.size(); ++i)
-      to_toml_value(l[i], key + "[" + std::to_string(i) + "]", [&](auto&& x) { a.push_back(std::forward<decltype(x)>(x)); });
-    return sink(std::move(a));
-  }
-  // numpy scalars and other numbers
-  if (py::hasattr(h, "__index__")) return sink(py::int_(h).cast<std::int64_t>());
-  if (py::hasattr(h, "__float__")) return sink(py::float_(h).cast<double>());
-  value_error("scene dict: " + key + " = " + show(h) + ": not a bool, number, string, list or dict");
 }
 
 std::string dict_to_toml(const py::dict& d) {
@@ -172,11 +187,14 @@ Scene to_scene(const py::handle& scene) {
 // The progress path of every long call: runs with the GIL released; every report takes the GIL,
 // checks for signals (Ctrl-C -> KeyboardInterrupt) and calls the user's callable. An exception
 // thrown here stops the library's loops and comes out of the call (ensemble.cpp GuardedProgress).
+// The callable is held through a shared_ptr: copies of the Progress (made without the GIL) touch no
+// Python reference count; the last copy dies in the caller, with the GIL held.
 Progress python_progress(const py::object& callback) {
-  return [callback](std::uint64_t done, std::uint64_t total) {
+  auto held = std::make_shared<py::object>(callback);
+  return [held](std::uint64_t done, std::uint64_t total) {
     py::gil_scoped_acquire gil;
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    if (!callback.is_none()) callback(done, total);
+    if (!held->is_none()) (*held)(done, total);
   };
 }
 
@@ -225,7 +243,7 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
   }
   py::dict report = py::module_::import("json").attr("loads")(out.json);
   if (arrays) report["arrays"] = samples_to_dict(std::move(samples));
-  return std::move(report);
+  return report;
 }
 
 // ---- rough spheres and contact queries ----
@@ -317,7 +335,7 @@ py::object elementwise(const py::handle& x, F f) {
     py::gil_scoped_release nogil;
     for (std::size_t i = 0; i < n; ++i) o[i] = f(in[i]);
   }
-  return std::move(out);
+  return out;
 }
 
 ImpactScene impact_scene(std::uint64_t n, double R, double a, double speed, double omega_x, double omega_y, double beta, bool core) {
