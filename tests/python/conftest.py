@@ -6,6 +6,7 @@ by hand: PYTHONPATH=build/python ASPERITY_CLI=build/validate-geometry python3 -m
 import json
 import os
 import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -61,8 +62,9 @@ def cli_report(scene_path, *extra):
     cli = os.environ.get("ASPERITY_CLI")
     if not cli or not os.path.exists(cli):
         pytest.skip("ASPERITY_CLI (validate-geometry) not set")
-    out = scene_path.parent / ("cli-" + scene_path.stem)
-    r = subprocess.run([cli, "--scene", str(scene_path), "--out", str(out), "--quiet", *extra],
-                       capture_output=True, text=True)
+    import tomllib
+
+    outputs = tomllib.loads(scene_path.read_text())["outputs"]
+    r = subprocess.run([cli, "--scene", str(scene_path), "--quiet", *extra], capture_output=True, text=True)
     assert r.returncode in (0, 1), r.stderr
-    return json.loads((out / "report.json").read_text())
+    return json.loads((Path(outputs["dir"]) / outputs["report"]).read_text())
