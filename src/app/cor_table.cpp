@@ -3,8 +3,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <iomanip>
 #include <sstream>
 #include <stdexcept>
 
@@ -16,10 +16,11 @@
 namespace asperity {
 namespace {
 
+// Shortest text that reads back to the same double (0.005, not 0.0050000000000000001).
 std::string num(double x) {
-  std::ostringstream o;
-  o << std::setprecision(17) << x;
-  return o.str();
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, r.ptr);
 }
 
 [[noreturn]] void bad(const std::string& field, const std::string& value, const std::string& why) {

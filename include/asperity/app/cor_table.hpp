@@ -60,7 +60,7 @@ struct CorTable {
 CorTable make_cor_table(const CorTableSpec& spec, const Progress& progress = {});
 
 /// The CSV text (README "Restitution tables"): '#' comment lines, a header row
-/// "speed_m_s,p=<p0>,p=<p1>,...", then one row per speed; numbers with 17 significant digits.
+/// "speed_m_s,p=<p0>,p=<p1>,...", then one row per speed; numbers in their shortest round-trip form.
 std::string cor_table_csv(const CorTable& t);
 /// The JSON header text.
 std::string cor_table_json(const CorTable& t);
