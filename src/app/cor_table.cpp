@@ -7,6 +7,8 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include "asperity/app/atomic_file.hpp"
 #include "asperity/config.hpp"
@@ -29,6 +31,14 @@ std::string num(double x) {
 
 // JSON numbers must be finite; NaN (an undefined standard error) is written as null.
 nlohmann::json finite_or_null(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+std::pair<double, double> mean_std(const std::vector<double>& x) {
+  double sum = 0, sq = 0;
+  for (const double e : x) sum += e;
+  const double mean = sum / static_cast<double>(x.size());
+  for (const double e : x) sq += (e - mean) * (e - mean);
+  return {mean, x.size() > 1 ? std::sqrt(sq / static_cast<double>(x.size() - 1)) : 0.0};
+}
 
 }  // namespace
 
@@ -92,12 +102,13 @@ CorTable make_cor_table(const CorTableSpec& spec, const Progress& progress) {
     row.core_contacts = static_cast<std::uint64_t>(std::count(s.eps_core.begin(), s.eps_core.end(), std::uint8_t{1}));
     if (s.eps.empty()) bad("speeds[" + std::to_string(i) + "]", num(row.speed), "no drop approached the plate");
     std::sort(s.eps.begin(), s.eps.end());
-    for (const double p : t.probabilities) row.quantiles.push_back(quantile_sorted(s.eps, p));
-    double sum = 0, sq = 0;
-    for (const double e : s.eps) sum += e;
-    row.mean = sum / static_cast<double>(s.eps.size());
-    for (const double e : s.eps) sq += (e - row.mean) * (e - row.mean);
-    row.std = s.eps.size() > 1 ? std::sqrt(sq / static_cast<double>(s.eps.size() - 1)) : 0.0;
+    std::sort(s.omega_x_after.begin(), s.omega_x_after.end());
+    for (const double p : t.probabilities) {
+      row.quantiles.push_back(quantile_sorted(s.eps, p));
+      row.omega_x_quantiles.push_back(quantile_sorted(s.omega_x_after, p));
+    }
+    std::tie(row.mean, row.std) = mean_std(s.eps);
+    std::tie(row.omega_x_mean, row.omega_x_std) = mean_std(s.omega_x_after);
     try {
       row.fit = fit_asymmetric_laplace_sorted(s.eps);
       row.fitted = true;
@@ -148,7 +159,8 @@ std::string cor_table_json(const CorTable& t) {
   json rows = json::array();
   for (const auto& r : t.rows) {
     json x = {{"speed_m_s", r.speed}, {"samples", r.samples}, {"core_contacts", r.core_contacts},
-              {"eps_n", r.eps_n}, {"mean", r.mean}, {"std", r.std}};
+              {"eps_n", r.eps_n}, {"mean", r.mean}, {"std", r.std},
+              {"omega_x_after", {{"mean", r.omega_x_mean}, {"std", r.omega_x_std}, {"quantiles", r.omega_x_quantiles}}}};
     if (r.fitted)
       x["eq2_fit"] = {{"m", r.fit.law.m}, {"a", r.fit.law.a()}, {"c", r.fit.law.c()},
                       {"se_m", finite_or_null(r.fit.m.se)}, {"se_a", finite_or_null(r.fit.a.se)},

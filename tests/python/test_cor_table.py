@@ -23,6 +23,9 @@ def test_table_quantiles_and_header(tmp_path):
     np.testing.assert_allclose(t["p"], np.linspace(0, 1, 11), rtol=0, atol=1e-15)
     assert t["format_version"] == 1 and t["body"]["N"] == 100000
     assert len(t["rows"]) == 3 and all("m" in r["eq2_fit"] for r in t["rows"])
+    # the spin after the impact: its marginal quantiles on the same grid, centred on Omega_x = 0.2
+    w = np.array(t["rows"][1]["omega_x_after"]["quantiles"])
+    assert w.shape == (11,) and np.all(np.diff(w) >= 0) and w[0] < 0.2 < w[-1]
     assert sorted(t["files"]) == sorted([str(path), str(path.with_suffix(".json"))])
     header = json.loads(path.with_suffix(".json").read_text())
     assert header["speeds_m_s"] == [0.5, 1.0, 2.0]

@@ -44,6 +44,10 @@ struct CorTableRow {
   std::uint64_t core_contacts = 0;
   double mean = 0, std = 0;        ///< of eps
   double eps_n = 0;                ///< microscopic eps_n(u) of the material
+  /// Omega'_x after the impact [rad/s]: quantiles on the same probability grid, mean and std. Its
+  /// marginal law only (it is correlated with eps; the CSV and cor_table.h sample eps alone).
+  std::vector<double> omega_x_quantiles;
+  double omega_x_mean = 0, omega_x_std = 0;
   LaplaceFit fit;                  ///< Eq. 2 fitted to the row's eps (maximum likelihood)
   bool fitted = false;             ///< false when the fit was impossible (e.g. all eps equal)
   std::string fit_note;            ///< why not, if !fitted
