@@ -95,6 +95,9 @@ CorTable make_cor_table(const CorTableSpec& spec, const Progress& progress) {
     Progress p;
     if (progress) p = [&](std::uint64_t done, std::uint64_t) { progress(offset + done, total); };
     ContactSamples s = run_contact_ensemble(c, p);
+    // The ensemble reports from its thread 0 only, which may get no chunk of a small run: one
+    // report per speed from here, so progress (and a Python binding's Ctrl-C check) always runs.
+    if (progress) progress(offset + spec.drops, total);
     CorTableRow row;
     row.speed = spec.speeds[i];
     row.samples = s.eps.size();
