@@ -516,7 +516,12 @@ of the scene's outputs are written as by the CLI; the report file is not.)doc");
           if (!(J > 0) || !std::isfinite(J)) value_error("inertia = " + show(inertia) + ": must be finite and > 0");
           body.inertia = J * Eigen::Matrix3d::Identity();
         } else {
-          Doubles a = py::cast<Doubles>(inertia);
+          Doubles a;
+          try {
+            a = py::cast<Doubles>(inertia);
+          } catch (const py::cast_error&) {
+            value_error("inertia: expected a number or a 3x3 array, got " + show(inertia));
+          }
           if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3) value_error("inertia: expected a number or a 3x3 array");
           for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) body.inertia(i, j) = a.at(i, j);
@@ -616,9 +621,17 @@ without an impact (v_n >= 0) are NaN with impact False.)doc");
          const py::object& path, const py::object& progress) {
         check_callable(progress);
         CorTableSpec spec = cor_table_spec(to_scene(scene));
-        if (!speeds.is_none()) spec.speeds = speeds.cast<std::vector<double>>();
+        try {
+          if (!speeds.is_none()) spec.speeds = speeds.cast<std::vector<double>>();
+        } catch (const py::cast_error&) {
+          value_error("speeds: expected a sequence of numbers [m/s], got " + show(speeds));
+        }
         spec.probabilities = probabilities;
-        if (!drops.is_none()) spec.drops = drops.cast<std::uint64_t>();
+        if (!drops.is_none()) {
+          if (!py::isinstance<py::int_>(drops) || drops.cast<py::int_>() < py::int_(0))
+            value_error("drops = " + show(drops) + ": expected a positive integer");
+          spec.drops = drops.cast<std::uint64_t>();
+        }
         validate(spec);
         const std::string file = path.is_none() ? std::string() : py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
         const Progress p = python_progress(progress);

@@ -50,6 +50,10 @@ def test_table_progress_and_bad_input():
         small(speeds=[1.0, 0.5])
     with pytest.raises(ValueError, match="probabilities"):
         small(probabilities=1)
+    with pytest.raises(ValueError, match="-5"):
+        small(drops=-5)
+    with pytest.raises(ValueError, match="speeds"):
+        small(speeds="fast")
     with pytest.raises(ValueError, match="not a sphere impact scene"):
         small(scene="fig6")
 
