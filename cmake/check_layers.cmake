@@ -1,6 +1,6 @@
 # Refuses an include edge that runs upwards through the layers core <- laws <- experiments <- app:
 # every #include "asperity/<layer>/..." or "<layer>/..." (private src/ headers) in
-# include/asperity/<layer>/ and src/<layer>/ must name the same layer or one below.
+# include/asperity/<layer>/ and src/<layer>/ must name the same layer or one below (src/python/ is app).
 # cmake -DROOT=<source dir> -P check_layers.cmake
 set(rank_core 0)
 set(rank_laws 1)
@@ -10,6 +10,10 @@ set(bad "")
 set(checked 0)
 foreach(layer core laws experiments app)
   file(GLOB_RECURSE files "${ROOT}/include/asperity/${layer}/*" "${ROOT}/src/${layer}/*")
+  if(layer STREQUAL "app")
+    file(GLOB_RECURSE python_files "${ROOT}/src/python/*")  # the Python module is app level
+    list(APPEND files ${python_files})
+  endif()
   foreach(f IN LISTS files)
     file(STRINGS "${f}" lines REGEX "^[ \t]*#[ \t]*include[ \t]*[\"<]")
     math(EXPR checked "${checked} + 1")

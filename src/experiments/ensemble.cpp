@@ -103,18 +103,47 @@ void store(ContactSamples& s, std::size_t i, const Contact& c) {
 // index, so the chunking never changes a result.
 constexpr std::uint64_t kChunk = 4096;
 
+// A progress callback may throw (a cancel request, a Python binding's KeyboardInterrupt). An
+// exception must not leave an OpenMP region, so it is caught on the thread that called progress,
+// the remaining chunks are skipped, and it is rethrown after the region by rethrow().
+class GuardedProgress {
+ public:
+  explicit GuardedProgress(const Progress& p) : p_(p) {}
+  bool stopped() const noexcept { return stop_.load(std::memory_order_relaxed); }
+  /// Called by one thread at a time (thread 0 of the team).
+  void operator()(std::uint64_t done, std::uint64_t total) noexcept {
+    if (!p_ || stopped()) return;
+    try {
+      p_(done, total);
+    } catch (...) {
+      error_ = std::current_exception();
+      stop_.store(true, std::memory_order_relaxed);
+    }
+  }
+  void rethrow() const {
+    if (error_) std::rethrow_exception(error_);
+  }
+
+ private:
+  const Progress& p_;
+  std::atomic<bool> stop_{false};
+  std::exception_ptr error_;
+};
+
 template <class Body>
-void for_chunks(std::uint64_t total, std::uint64_t offset, std::uint64_t grand_total, const Progress& progress,
+void for_chunks(std::uint64_t total, std::uint64_t offset, std::uint64_t grand_total, GuardedProgress& progress,
                 Body body) {
   const std::int64_t chunks = static_cast<std::int64_t>((total + kChunk - 1) / kChunk);
   std::atomic<std::uint64_t> done{0};
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t c = 0; c < chunks; ++c) {
+    if (progress.stopped()) continue;
     const std::uint64_t b = static_cast<std::uint64_t>(c) * kChunk, e = std::min(total, b + kChunk);
     body(b, e);
     const std::uint64_t now = done.fetch_add(e - b) + (e - b);
-    if (progress && omp_get_thread_num() == 0) progress(offset + now, grand_total);
+    if (omp_get_thread_num() == 0) progress(offset + now, grand_total);
   }
+  progress.rethrow();
 }
 
 // One impact per drop with the closed-form impulse (tested against the general 3x3 solve).
@@ -165,8 +194,9 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
 
 }  // namespace
 
-ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& progress) {
+ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& user_progress) {
   validate(c);
+  GuardedProgress progress(user_progress);
   if (c.threads > 0) omp_set_num_threads(c.threads);
   ContactSamples s;
   s.mode = c.mode;
@@ -233,6 +263,7 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& pro
 #pragma omp parallel for schedule(dynamic, 4) reduction(+ : gen, idx) reduction(max : bytes)
       for (std::int64_t kk = 0; kk < spheres; ++kk) {
         const auto k = static_cast<std::uint64_t>(kk);
+        if (progress.stopped()) continue;
         auto t = Clock::now();
         const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
         gen += since(t);
@@ -242,8 +273,9 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& pro
         bytes = std::max(bytes, index->memory_bytes());
         rotate(body, *index, k, 0, m);
         const std::uint64_t now = done.fetch_add(m) + m;
-        if (progress && omp_get_thread_num() == 0) progress(now, c.drops);
+        if (omp_get_thread_num() == 0) progress(now, c.drops);
       }
+      progress.rethrow();
       s.seconds_generate = gen, s.seconds_index = idx, s.index_bytes = bytes;
       s.seconds_query = since(t0);  // wall time of the whole loop, generation and indexing included
     }

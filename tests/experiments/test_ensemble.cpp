@@ -226,3 +226,21 @@ TEST(Impacts, BitIdenticalForOneAndTwoThreadsAndCoreContactsUseThePole) {
 }
 
 }  // namespace
+
+// A progress callback that throws (a cancel, Python's KeyboardInterrupt) stops the run: the
+// exception comes out of run_contact_ensemble, never out of an OpenMP region (std::terminate).
+TEST(Progress, AnExceptionInTheCallbackStopsEveryMode) {
+  struct Cancel {};
+  for (const auto& [mode, spheres] : {std::pair{Mode::fresh, 1ull}, std::pair{Mode::fixed, 1ull}, std::pair{Mode::fixed, 64ull}}) {
+    EnsembleConfig c;
+    c.sphere.asperities = 1000;
+    c.mode = mode;
+    c.spheres = spheres;
+    c.drops = 64 * 4096;
+    c.threads = 2;
+    std::uint64_t calls = 0;
+    EXPECT_THROW(run_contact_ensemble(c, [&](std::uint64_t, std::uint64_t) { ++calls; throw Cancel{}; }), Cancel)
+        << to_string(mode) << " x " << spheres;
+    EXPECT_EQ(calls, 1u) << "the callback is not called again once it threw";
+  }
+}

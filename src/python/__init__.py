@@ -1,0 +1,9 @@
+"""asperity: explicit-geometry contacts and restitution statistics of rough particles.
+
+Thin bindings of the C++ library (README "Python"): asperity.run(scene) runs a scene as the CLI
+validate-geometry does and returns report.json as a dict (with per-drop numpy arrays for small
+runs); the core pieces (rough spheres, contact queries, the impulse solve, eps_n models, the laws)
+work on numpy arrays; asperity.cor_table(...) writes restitution tables for DEM codes.
+"""
+from ._asperity import *  # noqa: F401,F403
+from ._asperity import __version__  # noqa: F401

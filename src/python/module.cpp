@@ -1,0 +1,664 @@
+// The Python module asperity._asperity (README "Python"): thin bindings of the C++ library, one
+// translation unit. No physics here: every number comes from the library; this file converts
+// arguments (numpy arrays, dicts, callables) and results, releases the GIL while the library
+// computes, and turns Ctrl-C into KeyboardInterrupt through the progress path.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <toml++/toml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "asperity/app/cor_table.hpp"
+#include "asperity/app/plan.hpp"
+#include "asperity/app/run.hpp"
+#include "asperity/app/scene.hpp"
+#include "asperity/app/scene_file.hpp"
+#include "asperity/config.hpp"
+#include "asperity/core/contact.hpp"
+#include "asperity/core/geometry.hpp"
+#include "asperity/core/impact.hpp"
+#include "asperity/core/orientation.hpp"
+#include "asperity/core/restitution.hpp"
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/laws/theory.hpp"
+#include "asperity/laws/theory_impact.hpp"
+
+namespace py = pybind11;
+using namespace asperity;
+
+namespace {
+
+using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+[[noreturn]] void value_error(const std::string& what) { throw py::value_error(what); }
+
+std::string show(const py::handle& h) { return py::repr(h).cast<std::string>(); }
+
+// A std::vector moved into a numpy array without a copy: the capsule owns it.
+template <class T>
+py::array_t<T> to_numpy(std::vector<T>&& v) {
+  auto* owner = new std::vector<T>(std::move(v));
+  py::capsule free(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>({static_cast<py::ssize_t>(owner->size())}, {static_cast<py::ssize_t>(sizeof(T))}, owner->data(), free);
+}
+
+py::array_t<bool> to_numpy_bool(const std::vector<std::uint8_t>& v) {
+  py::array_t<bool> a(static_cast<py::ssize_t>(v.size()));
+  auto m = a.mutable_unchecked<1>();
+  for (std::size_t i = 0; i < v.size(); ++i) m(static_cast<py::ssize_t>(i)) = v[i] != 0;
+  return a;
+}
+
+// An (M, 3) array of vectors, or one vector of shape (3,) (then M = 1 and `single` is set).
+struct Vectors {
+  std::vector<Vec3> v;
+  bool single = false;
+};
+
+Vectors vectors(const py::handle& obj, const char* name) {
+  Doubles a;
+  try {
+    a = py::cast<Doubles>(obj);
+  } catch (const py::cast_error&) {
+    value_error(std::string(name) + ": expected an array of shape (M, 3) or (3,), got " + show(obj));
+  }
+  Vectors out;
+  if (a.ndim() == 1 && a.shape(0) == 3) {
+    out.single = true;
+    out.v.emplace_back(a.at(0), a.at(1), a.at(2));
+  } else if (a.ndim() == 2 && a.shape(1) == 3) {
+    const auto r = a.unchecked<2>();
+    out.v.resize(static_cast<std::size_t>(a.shape(0)));
+    for (py::ssize_t i = 0; i < a.shape(0); ++i) out.v[static_cast<std::size_t>(i)] = Vec3(r(i, 0), r(i, 1), r(i, 2));
+  } else {
+    std::ostringstream s;
+    s << name << ": expected shape (M, 3) or (3,), got shape (";
+    for (py::ssize_t i = 0; i < a.ndim(); ++i) s << (i ? ", " : "") << a.shape(i);
+    s << (a.ndim() == 1 ? ",)" : ")");
+    value_error(s.str());
+  }
+  for (std::size_t i = 0; i < out.v.size(); ++i)
+    if (!out.v[i].allFinite()) {
+      std::ostringstream s;
+      s << name << "[" << i << "] = (" << out.v[i].x() << ", " << out.v[i].y() << ", " << out.v[i].z() << "): not finite";
+      value_error(s.str());
+    }
+  return out;
+}
+
+py::array_t<double> vectors_to_numpy(const std::vector<Vec3>& v, bool single) {
+  if (single) {
+    py::array_t<double> a(3);
+    for (int k = 0; k < 3; ++k) a.mutable_at(k) = v.at(0)[k];
+    return a;
+  }
+  py::array_t<double> a({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+  auto m = a.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (int k = 0; k < 3; ++k) m(static_cast<py::ssize_t>(i), k) = v[i][k];
+  return a;
+}
+
+// ---- scenes: a path, a preset name, or a dict in the scene-file layout ----
+
+// A scalar (bool, int, float, str, numpy scalar) handed to sink; false for anything else.
+template <class Sink>
+bool toml_scalar(const py::handle& h, Sink sink) {
+  if (py::isinstance<py::bool_>(h)) return sink(h.cast<bool>()), true;
+  if (py::isinstance<py::int_>(h)) return sink(h.cast<std::int64_t>()), true;
+  if (py::isinstance<py::float_>(h)) return sink(h.cast<double>()), true;
+  if (py::isinstance<py::str>(h)) return sink(h.cast<std::string>()), true;
+  if (py::isinstance<py::dict>(h) || py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h))
+    return false;
+  const auto o = py::reinterpret_borrow<py::object>(h);
+  if (py::hasattr(h, "__index__")) return sink(py::int_(o).cast<std::int64_t>()), true;  // numpy integers
+  if (py::hasattr(h, "__float__")) return sink(py::float_(o).cast<double>()), true;      // numpy floats
+  return false;
+}
+
+bool is_sequence(const py::handle& h) {
+  return py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h);
+}
+
+toml::table to_toml_table(const py::dict& d, const std::string& key);
+
+toml::array to_toml_array(const py::handle& h, const std::string& key) {
+  toml::array a;
+  py::list l = py::isinstance<py::array>(h) ? py::list(h.attr("tolist")()) : py::list(py::reinterpret_borrow<py::object>(h));
+  for (std::size_t i = 0; i < l.size(); ++i) {
+    const std::string k = key + "[" + std::to_string(i) + "]";
+    const py::handle v = l[i];
+    if (toml_scalar(v, [&](auto&& x) { a.push_back(std::forward<decltype(x)>(x)); })) continue;
+    if (py::isinstance<py::dict>(v)) a.push_back(to_toml_table(v.cast<py::dict>(), k));
+    else if (is_sequence(v)) a.push_back(to_toml_array(v, k));
+    else value_error("scene dict: " + k + " = " + show(v) + ": not a bool, number, string, list or dict");
+  }
+  return a;
+}
+
+toml::table to_toml_table(const py::dict& d, const std::string& key) {
+  toml::table t;
+  for (const auto& [k, v] : d) {
+    if (!py::isinstance<py::str>(k)) value_error("scene dict: key " + show(k) + (key.empty() ? "" : " in " + key) + " is not a string");
+    const std::string name = k.cast<std::string>();
+    const std::string full = key.empty() ? name : key + "." + name;
+    if (v.is_none()) continue;  // None: the key is absent (its default)
+    if (toml_scalar(v, [&](auto&& x) { t.insert(name, std::forward<decltype(x)>(x)); })) continue;
+    if (py::isinstance<py::dict>(v)) t.insert(name, to_toml_table(v.cast<py::dict>(), full));
+    else if (is_sequence(v)) t.insert(name, to_toml_array(v, full));
+    else value_error("scene dict: " + full + " = " + show(v) + ": not a bool, number, string, list or dict");
+  }
+  return t;
+}
+
+std::string dict_to_toml(const py::dict& d) {
+  toml::table t = to_toml_table(d, "");
+  if (!t.contains("format")) t.insert("format", std::int64_t{kSceneFormatVersion});
+  std::ostringstream s;
+  s << t;
+  return s.str();
+}
+
+// SceneError and every other std::invalid_argument become ValueError (pybind11's translation).
+Scene to_scene(const py::handle& scene) {
+  if (py::isinstance<py::dict>(scene)) return parse_scene(dict_to_toml(scene.cast<py::dict>()), "scene dict");
+  if (py::isinstance<py::str>(scene) || py::hasattr(scene, "__fspath__")) {
+    const std::string s = py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>();
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(s, ec)) return load_scene(s);
+    for (const auto& p : preset_names())
+      if (p == s) return preset(s);
+    std::string names;
+    for (const auto& p : preset_names()) names += (names.empty() ? "" : ", ") + p;
+    value_error("scene: '" + s + "' is neither a scene file nor a preset (" + names + ")");
+  }
+  value_error("scene: expected a path, a preset name or a dict, got " + show(scene));
+}
+
+// The progress path of every long call: runs with the GIL released; every report takes the GIL,
+// checks for signals (Ctrl-C -> KeyboardInterrupt) and calls the user's callable. An exception
+// thrown here stops the library's loops and comes out of the call (ensemble.cpp GuardedProgress).
+// The callable is held through a shared_ptr: copies of the Progress (made without the GIL) touch no
+// Python reference count; the last copy dies in the caller, with the GIL held.
+Progress python_progress(const py::object& callback) {
+  auto held = std::make_shared<py::object>(callback);
+  return [held](std::uint64_t done, std::uint64_t total) {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (!held->is_none()) (*held)(done, total);
+  };
+}
+
+void check_callable(const py::object& progress) {
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) value_error("progress: expected a callable or None, got " + show(progress));
+}
+
+// ---- run ----
+
+py::dict samples_to_dict(ContactSamples&& s) {
+  py::dict d;
+  d["r_x"] = to_numpy(std::move(s.r_x));
+  d["r_y"] = to_numpy(std::move(s.r_y));
+  d["r_z"] = to_numpy(std::move(s.r_z));
+  d["r_xy"] = to_numpy(std::move(s.r_xy));
+  d["gap"] = to_numpy(std::move(s.gap));
+  d["core"] = to_numpy_bool(s.core);
+  if (!s.eps.empty() || !s.eps_core.empty()) {
+    d["eps"] = to_numpy(std::move(s.eps));
+    d["omega_x_after"] = to_numpy(std::move(s.omega_x_after));
+    d["eps_n"] = to_numpy(std::move(s.eps_n));
+    d["eps_core"] = to_numpy_bool(s.eps_core);
+  }
+  return d;
+}
+
+py::object run(const py::handle& scene_arg, const py::object& progress, const py::object& arrays_arg, std::uint64_t max_array_drops) {
+  check_callable(progress);
+  const Scene scene = to_scene(scene_arg);
+  bool arrays = false;
+  if (arrays_arg.is_none())
+    arrays = run_kind(scene) == RunKind::sphere && scene.ensemble.drops <= max_array_drops;
+  else if (arrays_arg.cast<bool>()) {
+    if (run_kind(scene) != RunKind::sphere)
+      value_error("arrays: per-drop arrays exist for sphere scenes only, not for a " + std::string(to_string(run_kind(scene))) + " scene");
+    arrays = true;
+  }
+  const Progress p = python_progress(progress);
+  SceneOutput out;
+  ContactSamples samples;
+  {
+    py::gil_scoped_release nogil;
+    out = run_scene_output(scene, p);
+    // The same drops again, bit-identical (every drop is a pure function of seed and index), kept.
+    if (arrays) samples = run_contact_ensemble(make_plan(scene).scene.ensemble, p);
+  }
+  py::dict report = py::module_::import("json").attr("loads")(out.json);
+  if (arrays) report["arrays"] = samples_to_dict(std::move(samples));
+  return report;
+}
+
+// ---- rough spheres and contact queries ----
+
+struct PySphere {
+  RoughSphere body;
+};
+
+struct PyQuery {
+  std::shared_ptr<PySphere> sphere;  // the index points into sphere->body.centres
+  std::unique_ptr<ContactQuery> index;
+};
+
+py::dict nearest_to_dict(const std::vector<Nearest>& n, bool single) {
+  std::vector<std::uint32_t> idx(n.size()), run(n.size());
+  std::vector<double> key(n.size()), rkey(n.size());
+  for (std::size_t i = 0; i < n.size(); ++i) idx[i] = n[i].index, key[i] = n[i].key, run[i] = n[i].runner_up, rkey[i] = n[i].runner_up_key;
+  py::dict d;
+  if (single) {
+    d["index"] = idx[0], d["key"] = key[0], d["runner_up"] = run[0], d["runner_up_key"] = rkey[0];
+  } else {
+    d["index"] = to_numpy(std::move(idx)), d["key"] = to_numpy(std::move(key));
+    d["runner_up"] = to_numpy(std::move(run)), d["runner_up_key"] = to_numpy(std::move(rkey));
+  }
+  return d;
+}
+
+void check_unit(const std::vector<Vec3>& d, const char* name) {
+  for (std::size_t i = 0; i < d.size(); ++i)
+    if (std::abs(d[i].norm() - 1.0) > 1e-9) {
+      std::ostringstream s;
+      s << name << "[" << i << "] = (" << d[i].x() << ", " << d[i].y() << ", " << d[i].z() << "): not a unit vector (|d| = " << d[i].norm() << ")";
+      value_error(s.str());
+    }
+}
+
+std::vector<Rotation> quaternions(const py::handle& obj, bool& single) {
+  Doubles a;
+  try {
+    a = py::cast<Doubles>(obj);
+  } catch (const py::cast_error&) {
+    value_error("q: expected quaternions (w, x, y, z) of shape (M, 4) or (4,), got " + show(obj));
+  }
+  single = a.ndim() == 1;
+  if (!((a.ndim() == 1 && a.shape(0) == 4) || (a.ndim() == 2 && a.shape(1) == 4)))
+    value_error("q: expected quaternions (w, x, y, z) of shape (M, 4) or (4,), got an array of " + std::to_string(a.ndim()) + " dimensions");
+  const py::ssize_t m = single ? 1 : a.shape(0);
+  const double* p = a.data();
+  std::vector<Rotation> q;
+  for (py::ssize_t i = 0; i < m; ++i) {
+    Rotation r(p[4 * i], p[4 * i + 1], p[4 * i + 2], p[4 * i + 3]);
+    const double n = r.norm();
+    if (!std::isfinite(n) || std::abs(n - 1.0) > 1e-9)
+      value_error("q[" + std::to_string(i) + "]: not a unit quaternion (|q| = " + std::to_string(n) + ")");
+    q.push_back(r);
+  }
+  return q;
+}
+
+// ---- restitution models ----
+
+std::shared_ptr<Restitution> restitution_model(const py::handle& h) {
+  if (py::isinstance<Restitution>(h)) return h.cast<std::shared_ptr<Restitution>>();
+  if (py::isinstance<py::float_>(h) || py::isinstance<py::int_>(h)) {
+    const double e = h.cast<double>();
+    if (!(e >= 0 && e <= 1)) value_error("eps_n = " + show(h) + ": must be in [0, 1]");
+    return constant_restitution(e);
+  }
+  value_error("eps_n: expected a number in [0, 1] or a restitution model (asperity.pade14, asperity.constant), got " + show(h));
+}
+
+// Evaluates a scalar function of the library elementwise over an array (GIL released), keeping
+// the input's shape; a Python float in, a float out.
+template <class F>
+py::object elementwise(const py::handle& x, F f) {
+  if (py::isinstance<py::float_>(x) || py::isinstance<py::int_>(x)) return py::float_(f(x.cast<double>()));
+  Doubles a;
+  try {
+    a = py::cast<Doubles>(x);
+  } catch (const py::cast_error&) {
+    value_error("x: expected a number or an array of numbers, got " + show(x));
+  }
+  std::vector<py::ssize_t> shape(a.shape(), a.shape() + a.ndim());
+  py::array_t<double> out(shape);
+  const double* in = a.data();
+  double* o = out.mutable_data();
+  const auto n = static_cast<std::size_t>(a.size());
+  {
+    py::gil_scoped_release nogil;
+    for (std::size_t i = 0; i < n; ++i) o[i] = f(in[i]);
+  }
+  return out;
+}
+
+ImpactScene impact_scene(std::uint64_t n, double R, double a, double speed, double omega_x, double omega_y, double beta, bool core) {
+  ImpactScene s;
+  s.asperities = n, s.radius = R, s.asperity_radius = a, s.speed = speed, s.omega_x = omega_x, s.omega_y = omega_y;
+  s.beta = beta, s.core_contacts = core;
+  return s;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_asperity, m) {
+  m.doc() = "asperity: explicit-geometry contacts and restitution of rough particles (C++ library bindings)";
+  m.attr("__version__") = ASPERITY_VERSION;
+
+  // -- scenes and runs
+  m.def("presets", &preset_names, "Names of the built-in preset scenes.");
+  m.def("preset_text", [](const std::string& name) { return std::string(preset_text(name)); }, py::arg("name"),
+        "The TOML text of a preset scene.");
+  m.def("scene_toml", [](const py::handle& scene) { return to_toml(to_scene(scene)); }, py::arg("scene"),
+        "The effective scene (path, preset name or dict) as a format-1 TOML document.");
+  m.def("run", &run, py::arg("scene"), py::arg("progress") = py::none(), py::arg("arrays") = py::none(),
+        py::arg("max_array_drops") = std::uint64_t{2000000},
+        R"doc(Runs a scene as validate-geometry does and returns report.json as a dict.
+
+scene: a scene file path, a preset name (asperity.presets()) or a dict in the scene-file layout.
+progress: None or a callable progress(done, total), called from this thread now and then.
+arrays: None (default) adds report["arrays"] (per-drop numpy arrays r_x, r_y, r_z, r_xy, gap,
+  core, and for impacts eps, omega_x_after, eps_n, eps_core) for sphere scenes of at most
+  max_array_drops drops; True/False forces. The arrays are the run's drops recomputed from the
+  same seed (bit-identical), which costs a second pass over the ensemble.
+The GIL is released while the run computes; Ctrl-C raises KeyboardInterrupt. Figures and files
+of the scene's outputs are written as by the CLI; the report file is not.)doc");
+
+  // -- rough spheres, contact queries
+  py::class_<PySphere, std::shared_ptr<PySphere>>(m, "RoughSphere", "An explicit rough sphere (core/geometry.hpp).")
+      .def_property_readonly("asperities", [](const PySphere& s) { return s.body.params.asperities; })
+      .def_property_readonly("radius", [](const PySphere& s) { return s.body.params.radius; })
+      .def_property_readonly("asperity_radius", [](const PySphere& s) { return s.body.params.asperity_radius; })
+      .def("__len__", [](const PySphere& s) { return s.body.centres.size(); })
+      .def_property_readonly(
+          "centres",
+          [](py::object self) {
+            auto& s = self.cast<PySphere&>();
+            static_assert(sizeof(Vec3) == 3 * sizeof(double));
+            py::array_t<double> a({static_cast<py::ssize_t>(s.body.centres.size()), py::ssize_t{3}},
+                                  {static_cast<py::ssize_t>(sizeof(Vec3)), static_cast<py::ssize_t>(sizeof(double))},
+                                  s.body.centres.empty() ? nullptr : s.body.centres.front().data(), self);
+            py::detail::array_proxy(a.ptr())->flags &= ~py::detail::npy_api::NPY_ARRAY_WRITEABLE_;
+            return a;
+          },
+          "Unit asperity centres u_i, shape (N, 3): a read-only view of the sphere's memory (no copy; keeps the sphere alive). "
+          "Centre i is at R u_i.")
+      .def(
+          "query",
+          [](std::shared_ptr<PySphere> self, const std::string& backend) {
+            auto q = std::make_shared<PyQuery>();
+            q->sphere = self;
+            const Backend b = parse_backend(backend);
+            py::gil_scoped_release nogil;
+            q->index = make_contact_query(b, self->body.centres);
+            return q;
+          },
+          py::arg("backend") = "grid", "A contact query index over the centres (brute, kdtree, cgal, fcl, grid).");
+  m.def(
+      "make_rough_sphere",
+      [](std::uint64_t n, double R, double a, std::uint64_t seed, std::uint64_t sphere_id) {
+        SphereParams p;
+        p.asperities = n, p.radius = R, p.asperity_radius = a;
+        validate(p);
+        auto s = std::make_shared<PySphere>();
+        py::gil_scoped_release nogil;
+        s->body = make_rough_sphere(p, seed, sphere_id);
+        return s;
+      },
+      py::arg("asperities") = 100000, py::arg("radius") = 3e-3, py::arg("asperity_radius") = 6.5e-7, py::arg("seed") = 1,
+      py::arg("sphere_id") = 0, "N asperity centres uniform on the sphere of radius R, a pure function of (seed, sphere_id).");
+  py::class_<PyQuery, std::shared_ptr<PyQuery>>(m, "ContactQuery")
+      .def_property_readonly("backend", [](const PyQuery& q) { return std::string(to_string(q.index->backend())); })
+      .def_property_readonly("memory_bytes", [](const PyQuery& q) { return q.index->memory_bytes(); })
+      .def(
+          "lowest",
+          [](const PyQuery& q, const py::handle& d) {
+            Vectors v = vectors(d, "d");
+            check_unit(v.v, "d");
+            std::vector<Nearest> out(v.v.size());
+            {
+              py::gil_scoped_release nogil;
+              q.index->lowest(v.v, out);
+            }
+            return nearest_to_dict(out, v.single);
+          },
+          py::arg("d"),
+          "The two lowest asperities for unit body-frame down directions d, shape (M, 3) or (3,): dict of index, key, "
+          "runner_up, runner_up_key.")
+      .def(
+          "contact",
+          [](const PyQuery& q, const py::handle& qs) {
+            bool single = false;
+            const std::vector<Rotation> rot = quaternions(qs, single);
+            std::vector<Vec3> d(rot.size()), r(rot.size());
+            std::vector<Nearest> nn(rot.size());
+            std::vector<double> rxy(rot.size()), gap(rot.size());
+            std::vector<std::uint8_t> core(rot.size());
+            std::vector<std::uint32_t> index(rot.size());
+            {
+              py::gil_scoped_release nogil;
+              for (std::size_t i = 0; i < rot.size(); ++i) d[i] = body_down(rot[i]);
+              q.index->lowest(d, nn);
+              const auto& b = q.sphere->body;
+              for (std::size_t i = 0; i < rot.size(); ++i) {
+                const Contact c = make_contact(nn[i], b.centres[nn[i].index], rot[i], b.params.radius, b.params.asperity_radius);
+                r[i] = c.r, rxy[i] = c.r_xy, gap[i] = c.gap, core[i] = c.core, index[i] = c.index;
+              }
+            }
+            py::dict out;
+            out["index"] = to_numpy(std::move(index));
+            out["r"] = vectors_to_numpy(r, false);
+            out["r_xy"] = to_numpy(std::move(rxy));
+            out["gap"] = to_numpy(std::move(gap));
+            out["core"] = to_numpy_bool(core);
+            return out;
+          },
+          py::arg("q"),
+          "World-frame contacts of the body rotated by unit quaternions q = (w, x, y, z), shape (M, 4): dict of index, r "
+          "(M, 3) [m], r_xy [m], gap [m], core.");
+  m.def("backends", [] {
+    std::vector<std::string> v;
+    for (const Backend b : all_backends()) v.emplace_back(to_string(b));
+    return v;
+  });
+  m.def(
+      "body_down",
+      [](const py::handle& qs) {
+        bool single = false;
+        const auto rot = quaternions(qs, single);
+        std::vector<Vec3> d;
+        for (const auto& r : rot) d.push_back(body_down(r));
+        return vectors_to_numpy(d, single);
+      },
+      py::arg("q"), "The world's down direction in the body frame of bodies rotated by unit quaternions (w, x, y, z).");
+
+  // -- restitution models and the impulse
+  py::class_<Restitution, std::shared_ptr<Restitution>>(m, "Restitution", "A microscopic eps_n(v) model (core/restitution.hpp).")
+      .def_property_readonly("name", &Restitution::name)
+      .def(
+          "__call__",
+          [](std::shared_ptr<Restitution> self, const py::handle& v) {
+            return elementwise(v, [&](double x) {
+              if (!(x >= 0) || !std::isfinite(x)) throw std::invalid_argument("v = " + std::to_string(x) + ": speed must be finite and >= 0");
+              return (*self)(x);
+            });
+          },
+          py::arg("v"), "eps_n at normal contact speeds v >= 0 [m/s] (a number or an array).");
+  m.def(
+      "pade14",
+      [](double beta) -> std::shared_ptr<Restitution> {
+        if (!(beta > 0) || !std::isfinite(beta)) value_error("beta = " + std::to_string(beta) + ": must be finite and > 0");
+        return viscoelastic_pade14(beta);
+      },
+      py::arg("beta") = 0.0467, "Viscoelastic eps_n, Pade [1/4] of Eq. 9.");
+  m.def(
+      "constant",
+      [](double e) -> std::shared_ptr<Restitution> {
+        if (!(e >= 0 && e <= 1)) value_error("e = " + std::to_string(e) + ": must be in [0, 1]");
+        return constant_restitution(e);
+      },
+      py::arg("e"), "eps_n = e at every speed.");
+  m.def(
+      "solve_impact",
+      [](double mass, const py::handle& inertia, const py::handle& V, const py::handle& Omega, const py::handle& r,
+         const py::handle& n, const py::handle& eps_n, double eps_t) {
+        if (!(mass > 0) || !std::isfinite(mass)) value_error("mass = " + std::to_string(mass) + ": must be finite and > 0");
+        RigidBody body;
+        body.mass = mass;
+        if (py::isinstance<py::float_>(inertia) || py::isinstance<py::int_>(inertia)) {
+          const double J = inertia.cast<double>();
+          if (!(J > 0) || !std::isfinite(J)) value_error("inertia = " + show(inertia) + ": must be finite and > 0");
+          body.inertia = J * Eigen::Matrix3d::Identity();
+        } else {
+          Doubles a;
+          try {
+            a = py::cast<Doubles>(inertia);
+          } catch (const py::cast_error&) {
+            value_error("inertia: expected a number or a 3x3 array, got " + show(inertia));
+          }
+          if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3) value_error("inertia: expected a number or a 3x3 array");
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) body.inertia(i, j) = a.at(i, j);
+        }
+        const auto model = restitution_model(eps_n);
+        Vectors vv = vectors(V, "V"), vo = vectors(Omega, "Omega"), vr = vectors(r, "r"), vn = vectors(n, "n");
+        std::size_t m = 1;
+        for (const Vectors* x : {&vv, &vo, &vr, &vn})
+          if (!x->single) {
+            if (m != 1 && x->v.size() != m) value_error("V, Omega, r, n: arrays of different lengths (" + std::to_string(m) + " and " + std::to_string(x->v.size()) + ")");
+            m = x->v.size();
+          }
+        const bool single = vv.single && vo.single && vr.single && vn.single;
+        auto at = [](const Vectors& x, std::size_t i) -> const Vec3& { return x.single ? x.v[0] : x.v[i]; };
+        std::vector<Vec3> P(m), Va(m), Oa(m);
+        std::vector<double> eps(m), en(m), vnv(m);
+        std::vector<std::uint8_t> impact(m);
+        {
+          py::gil_scoped_release nogil;
+          const double nan = std::nan("");
+          for (std::size_t i = 0; i < m; ++i) {
+            ImpactState s;
+            s.V = at(vv, i), s.Omega = at(vo, i), s.r = at(vr, i), s.n = at(vn, i);
+            const auto res = solve_impact(body, s, *model, eps_t);
+            impact[i] = res.has_value();
+            if (res) {
+              P[i] = res->P, Va[i] = res->V_after, Oa[i] = res->Omega_after, eps[i] = res->eps, en[i] = res->eps_n, vnv[i] = res->v_n;
+            } else {
+              P[i] = Va[i] = Oa[i] = Vec3::Constant(nan);
+              eps[i] = en[i] = nan;
+              vnv[i] = (s.V + s.Omega.cross(s.r)).dot(s.n);
+            }
+          }
+        }
+        py::dict out;
+        out["P"] = vectors_to_numpy(P, single);
+        out["V_after"] = vectors_to_numpy(Va, single);
+        out["Omega_after"] = vectors_to_numpy(Oa, single);
+        if (single) {
+          out["eps"] = eps[0], out["eps_n"] = en[0], out["v_n"] = vnv[0], out["impact"] = impact[0] != 0;
+        } else {
+          out["eps"] = to_numpy(std::move(eps)), out["eps_n"] = to_numpy(std::move(en)), out["v_n"] = to_numpy(std::move(vnv));
+          out["impact"] = to_numpy_bool(impact);
+        }
+        return out;
+      },
+      py::arg("mass"), py::arg("inertia"), py::arg("V"), py::arg("Omega"), py::arg("r"), py::arg("n") = std::vector<double>{0, 0, 1},
+      py::arg("eps_n") = 1.0, py::arg("eps_t") = 1.0,
+      R"doc(Impulse solve of Eq. 7 (core/impact.hpp) over arrays: V, Omega, r, n of shape (M, 3) or (3,)
+(broadcast); inertia a number (J = inertia x identity) or a 3x3 world-frame tensor; eps_n a number or
+a model (asperity.pade14()). Returns a dict of P, V_after, Omega_after, eps, eps_n, v_n, impact; rows
+without an impact (v_n >= 0) are NaN with impact False.)doc");
+
+  // -- laws
+  py::class_<Law>(m, "Law", "A one-dimensional law with pdf and cdf (laws/theory.hpp).")
+      .def_readonly("name", &Law::name)
+      .def_readonly("description", &Law::description)
+      .def_readonly("mean", &Law::mean)
+      .def("pdf", [](const Law& l, const py::handle& x) { return elementwise(x, [&](double t) { return l.pdf(t); }); }, py::arg("x"))
+      .def("cdf", [](const Law& l, const py::handle& x) { return elementwise(x, [&](double t) { return l.cdf(t); }); }, py::arg("x"))
+      .def("__repr__", [](const Law& l) { return "<asperity.Law " + l.name + ": " + l.description + ">"; });
+  auto check_nr = [](std::uint64_t n, double R) {
+    check_asperity_count(n, "asperities");
+    if (!(R > 0) || !std::isfinite(R)) value_error("radius = " + std::to_string(R) + ": must be finite and > 0");
+  };
+  m.def("eq14_rxy", [=](std::uint64_t n, double R) { check_nr(n, R); return eq14_rxy(n, R); }, py::arg("asperities"), py::arg("radius"),
+        "Eq. 14: law of r_xy [m] (flat cap, Poisson points; Rayleigh).");
+  m.def("exact_sphere_rxy", [=](std::uint64_t n, double R) { check_nr(n, R); return exact_sphere_rxy(n, R); }, py::arg("asperities"),
+        py::arg("radius"), "Exact finite-N law of r_xy [m] on the sphere.");
+  m.def("eq18_rx", [=](std::uint64_t n, double R) { check_nr(n, R); return eq18_rx(n, R); }, py::arg("asperities"), py::arg("radius"),
+        "Eq. 18: law of r_x [m] (Normal).");
+  m.def("exact_sphere_rx", [=](std::uint64_t n, double R) { check_nr(n, R); return exact_sphere_rx(n, R); }, py::arg("asperities"),
+        py::arg("radius"), "Exact finite-N law of r_x [m] on the sphere.");
+  m.def("core_contact_probability", [=](std::uint64_t n, double R, double a) { check_nr(n, R); return core_contact_probability(n, R, a); },
+        py::arg("asperities"), py::arg("radius"), py::arg("asperity_radius"));
+#define ASPERITY_IMPACT_LAW(fn, doc)                                                                                        \
+  m.def(                                                                                                                    \
+      #fn,                                                                                                                  \
+      [](std::uint64_t n, double R, double a, double speed, double omega_x, double omega_y, double beta, bool core) {       \
+        const ImpactScene s = impact_scene(n, R, a, speed, omega_x, omega_y, beta, core);                                   \
+        validate(s);                                                                                                        \
+        return fn(s);                                                                                                       \
+      },                                                                                                                    \
+      py::arg("asperities") = 100000, py::arg("radius") = 3e-3, py::arg("asperity_radius") = 6.5e-7, py::arg("speed") = 1.3, \
+      py::arg("omega_x") = 0.2, py::arg("omega_y") = 0.0, py::arg("beta") = 0.0467, py::arg("core_contacts") = false, doc)
+  ASPERITY_IMPACT_LAW(eq28_printed, "Eq. 28 as printed: law of eps (normalised; see the description).");
+  ASPERITY_IMPACT_LAW(eq28_corrected, "Eq. 28 corrected: law of eps (docs/sec4-derivations.md).");
+  ASPERITY_IMPACT_LAW(eq28_paper_route, "The paper's route to Eq. 28 carried out correctly: law of eps.");
+  ASPERITY_IMPACT_LAW(eq33_printed, "Eq. 33 as printed: law of Omega'_x [rad/s].");
+  ASPERITY_IMPACT_LAW(eq33_corrected, "Eq. 33 corrected: law of Omega'_x [rad/s].");
+#undef ASPERITY_IMPACT_LAW
+
+  // -- restitution tables
+  m.def(
+      "cor_table",
+      [](const py::handle& scene, const py::object& speeds, std::size_t probabilities, const py::object& drops,
+         const py::object& path, const py::object& progress) {
+        check_callable(progress);
+        CorTableSpec spec = cor_table_spec(to_scene(scene));
+        try {
+          if (!speeds.is_none()) spec.speeds = speeds.cast<std::vector<double>>();
+        } catch (const py::cast_error&) {
+          value_error("speeds: expected a sequence of numbers [m/s], got " + show(speeds));
+        }
+        spec.probabilities = probabilities;
+        if (!drops.is_none()) {
+          if (!py::isinstance<py::int_>(drops) || drops.cast<py::int_>() < py::int_(0))
+            value_error("drops = " + show(drops) + ": expected a positive integer");
+          spec.drops = drops.cast<std::uint64_t>();
+        }
+        validate(spec);
+        const std::string file = path.is_none() ? std::string() : py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        const Progress p = python_progress(progress);
+        CorTable t;
+        std::vector<std::filesystem::path> files;
+        {
+          py::gil_scoped_release nogil;
+          t = make_cor_table(spec, p);
+          if (!file.empty()) files = write_cor_table(file, t);
+        }
+        std::vector<double> q;
+        for (const auto& row : t.rows) q.insert(q.end(), row.quantiles.begin(), row.quantiles.end());
+        py::dict out = py::module_::import("json").attr("loads")(cor_table_json(t));
+        out["speeds"] = to_numpy(std::vector<double>(spec.speeds));
+        out["p"] = to_numpy(std::vector<double>(t.probabilities));
+        out["quantiles"] = to_numpy(std::move(q)).reshape({static_cast<py::ssize_t>(t.rows.size()), static_cast<py::ssize_t>(t.probabilities.size())});
+        py::list written;
+        for (const auto& f : files) written.append(f.string());
+        out["files"] = written;
+        return out;
+      },
+      py::arg("scene") = "fig4", py::arg("speeds") = py::none(), py::arg("probabilities") = 201, py::arg("drops") = py::none(),
+      py::arg("path") = py::none(), py::arg("progress") = py::none(),
+      R"doc(A restitution table for DEM codes (app/cor_table.hpp; README "Restitution tables").
+
+The sphere, material, spin and seed come from `scene` (a sphere impact scene); speeds [m/s]
+default to 9 points from u/10 to 10 u around its impact speed u; drops (fresh spheres per speed)
+default to 1e5. Returns the JSON header as a dict plus arrays speeds, p, quantiles (speeds x p);
+with path, writes path (CSV) and the .json next to it (files lists them).)doc");
+}

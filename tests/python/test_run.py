@@ -1,0 +1,150 @@
+"""asperity.run against the CLI, the arrays, progress, Ctrl-C and bad input."""
+import math
+import os
+import signal
+import threading
+
+import numpy as np
+import pytest
+
+import asperity
+from conftest import cli_report
+
+# Wall-clock fields differ between two runs of the same scene; everything else must be equal.
+VOLATILE = {"timings_s", "seconds", "wall_s"}
+
+
+def volatile(key):
+    return key in VOLATILE or key.endswith("seconds") or key.endswith("_s") and "time" in key
+
+
+def assert_same(cli, py, path="report"):
+    """Every field of the CLI's report is in the module's, equal (extra fields are tolerated)."""
+    if isinstance(cli, dict):
+        assert isinstance(py, dict), path
+        for k, v in cli.items():
+            if volatile(k):
+                continue
+            assert k in py, f"{path}.{k} missing from asperity.run"
+            assert_same(v, py[k], f"{path}.{k}")
+    elif isinstance(cli, list):
+        assert isinstance(py, list) and len(py) == len(cli), path
+        for i, (a, b) in enumerate(zip(cli, py)):
+            assert_same(a, b, f"{path}[{i}]")
+    elif isinstance(cli, float) and math.isnan(cli):
+        assert isinstance(py, float) and math.isnan(py), path
+    else:
+        assert cli == py, f"{path}: CLI {cli!r} != module {py!r}"
+
+
+@pytest.mark.parametrize("mode,spheres", [("fresh", 1), ("fixed", 4)])
+def test_run_equals_cli_report(small_scene, mode, spheres):
+    scene = small_scene(mode=mode, spheres=spheres, drops=20000)
+    cli = cli_report(scene)
+    py = asperity.run(scene)
+    assert_same(cli, py)
+    assert py["scene"] == "small-impact"
+
+
+def test_dict_scene_equals_file_scene(small_scene):
+    import tomllib
+
+    scene = small_scene(drops=5000)
+    as_dict = tomllib.loads(scene.read_text())
+    a = asperity.run(scene, arrays=False)
+    b = asperity.run(as_dict, arrays=False)
+    assert_same(a, b)
+
+
+def test_arrays_are_the_reported_drops(small_scene):
+    r = asperity.run(small_scene(drops=20000))
+    arr = r["arrays"]
+    for name in ("r_x", "r_y", "r_z", "r_xy", "gap", "core", "eps", "omega_x_after", "eps_n", "eps_core"):
+        assert isinstance(arr[name], np.ndarray), name
+    assert arr["r_x"].shape == (20000,)
+    assert arr["core"].dtype == np.bool_
+    q = {x["name"]: x for x in r["quantities"]} if isinstance(r.get("quantities"), list) else None
+    # The report's sample count and mean of eps are those of the arrays.
+    assert r["samples"] == arr["r_x"].size
+    if q and "eps" in q:
+        mean = q["eps"]["mean"] if not isinstance(q["eps"]["mean"], dict) else q["eps"]["mean"]["value"]
+        assert mean == pytest.approx(float(np.mean(arr["eps"])), rel=1e-12)
+    # Owned by numpy without a copy of their own: the base is the capsule holding the C++ vector.
+    assert arr["eps"].base is not None
+
+
+def test_arrays_only_when_asked_or_small(small_scene):
+    assert "arrays" not in asperity.run(small_scene(drops=5000), arrays=False)
+    assert "arrays" not in asperity.run(small_scene(drops=5000), max_array_drops=1000)
+
+
+def test_progress_is_called(small_scene):
+    calls = []
+    asperity.run(small_scene(drops=40000), progress=lambda done, total: calls.append((done, total)), arrays=False)
+    assert calls, "progress never called"
+    assert all(t == 40000 and 0 < d <= t for d, t in calls)
+
+
+def test_exception_in_progress_propagates(small_scene):
+    class Stop(Exception):
+        pass
+
+    def progress(done, total):
+        raise Stop(f"{done}/{total}")
+
+    with pytest.raises(Stop):
+        asperity.run(small_scene(drops=200000, mode="fixed", spheres=2), progress=progress)
+
+
+def test_ctrl_c_interrupts(small_scene):
+    # SIGINT delivered to this process while the run computes (GIL released): KeyboardInterrupt
+    # at the next progress step, long before the run would have finished (load-independent: the
+    # drops done when it stopped are counted, not seconds).
+    scene = small_scene(drops=1_000_000, mode="fixed", spheres=1, count=20_000, backend="brute")
+    done = []
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        asperity.run(scene, arrays=False, progress=lambda d, t: done.append(d))
+    timer.join()
+    assert max(done, default=0) < 500_000
+
+
+def test_gil_is_released(small_scene):
+    # Another Python thread keeps running while asperity.run computes.
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(1)
+            stop.wait(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    asperity.run(small_scene(drops=200000), arrays=False)
+    stop.set()
+    t.join()
+    assert len(ticks) > 10
+
+
+@pytest.mark.parametrize("scene,needle", [
+    ("no-such-preset", "no-such-preset"),
+    ({"format": 1, "ensemble": {"drops": -5}}, "drops"),
+    ({"format": 1, "ensemble": {"mode": "sideways"}}, "sideways"),
+    ({"format": 1, "bogus": 1}, "bogus"),
+    (42, "42"),
+])
+def test_bad_scene_raises_value_error_naming_it(scene, needle):
+    with pytest.raises(ValueError, match=needle):
+        asperity.run(scene)
+
+
+def test_bad_progress_raises_value_error():
+    with pytest.raises(ValueError, match="progress"):
+        asperity.run("fig3", progress=3)
+
+
+def test_presets():
+    assert "fig3" in asperity.presets()
+    assert "N = 1e5" in asperity.preset_text("fig3") or "fig3" in asperity.preset_text("fig3")
