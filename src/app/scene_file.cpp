@@ -1,6 +1,8 @@
 // Scene files (format 1). toml++ is used header-only, in this translation unit only.
 #include "asperity/app/scene_file.hpp"
 
+#include "asperity/app/output_staging.hpp"
+
 #define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
 #include <toml++/toml.h>
 
@@ -383,7 +385,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
         ens->bad("backend", "only mode = \"fixed\" queries a contact index (fresh mode draws the lowest asperities "
                             "exactly): \"auto\" or absent, got \"" + *b + "\"");
     }
-    if (auto t = ens->count("threads", 0, 4096)) e.threads = static_cast<int>(*t);
+    if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
     ens->finish();
   }
 
@@ -505,14 +507,17 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     }
     if (auto d = out->text("dir")) s.out = *d;
     if (auto r = out->text("report")) {
-      if (r->find('/') != std::string::npos || *r == "." || *r == "..")
-        out->bad("report", "must be a file name inside outputs.dir, got " + quote(*r));
+      if (const std::string why = output_name_problem(*r); !why.empty())
+        out->bad("report", "must be a plain file name inside outputs.dir, got " + quote(*r) + ": it " + why);
       s.report = *r;
     }
     if (auto p = out->text("export_ply")) {
       if (!s.mesh) out->bad("export_ply", "only for body.kind = \"mesh\"");
-      if (p->find('/') != std::string::npos || *p == "." || *p == "..")
-        out->bad("export_ply", "must be a file name inside outputs.dir, got " + quote(*p));
+      if (const std::string why = output_name_problem(*p); !why.empty())
+        out->bad("export_ply", "must be a plain file name inside outputs.dir, got " + quote(*p) + ": it " + why);
+      if (*p == s.report || *p == report_table_name(s.report))
+        out->bad("export_ply", quote(*p) + " is also the name of the report or its table (" + quote(s.report) + ", " +
+                                   quote(report_table_name(s.report)) + ")");
       s.mesh->export_ply = *p;
     }
     if (auto st = out->choice("export_style", {"spheres", "points"})) {
