@@ -377,13 +377,17 @@ void run_gnuplot(const char* who, const fs::path& png, const std::function<std::
   if (spawn_error != 0)
     throw std::runtime_error(w + ": cannot run gnuplot: " + std::generic_category().message(spawn_error) +
                              " (is gnuplot installed? scripts/setup)");
-  const std::string full = space_note(png.parent_path());
-  if (!ok)
-    throw std::runtime_error(w + ": gnuplot failed writing " + png.string() + full +
-                             (messages.empty() ? std::string(" (no message)") : ":\n" + messages));
-  if (!fs::is_regular_file(out, ec) || fs::file_size(out, ec) == 0 || ec)
-    throw std::runtime_error(w + ": gnuplot produced no output for " + png.string() + full +
+  const bool produced = fs::is_regular_file(out, ec) && fs::file_size(out, ec) > 0 && !ec;
+  if (!ok || !produced) {
+    // A full disk explains itself; gnuplot's warnings would only hide it.
+    if (const std::string full = space_note(png.parent_path()); !full.empty())
+      throw std::runtime_error(w + ": cannot write " + png.string() + full);
+    if (!ok)
+      throw std::runtime_error(w + ": gnuplot failed writing " + png.string() +
+                               (messages.empty() ? std::string(" (no message)") : ":\n" + messages));
+    throw std::runtime_error(w + ": gnuplot produced no output for " + png.string() +
                              (messages.empty() ? std::string() : ":\n" + messages));
+  }
 
   fs::rename(out, png, ec);
   if (ec) throw std::runtime_error(w + ": cannot rename onto " + png.string() + ": " + ec.message());

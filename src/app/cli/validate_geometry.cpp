@@ -83,6 +83,12 @@ int main(int argc, char** argv) {
   // Every file goes into a staging directory inside the output directory and is renamed into
   // place only when the whole run succeeded (the report last): a failed or interrupted run
   // leaves the directory as it found it (output_staging.hpp).
+  std::string staging_dir;  // messages name the files where they were going, not the staging copy
+  auto where = [&](std::string message) {
+    for (std::size_t at; !staging_dir.empty() && (at = message.find(staging_dir)) != std::string::npos;)
+      message.replace(at, staging_dir.size(), scene.out.string());
+    return message;
+  };
   try {
     std::optional<OutputStaging> staging;
     try {
@@ -90,6 +96,7 @@ int main(int argc, char** argv) {
     } catch (const std::exception& ex) {
       throw BadInput(std::string("--out: ") + ex.what());
     }
+    staging_dir = staging->dir().string();
     const bool sequences = run_kind(scene) == RunKind::mesh_bounce || run_kind(scene) == RunKind::bounce;
     ProgressLine progress(!quiet, stderr, ::isatty(2) != 0, &ProgressLine::steady_seconds, 1.0,
                           sequences ? "sequences" : "drops");
@@ -121,7 +128,7 @@ int main(int argc, char** argv) {
               << scene.out.string() << " is as it was\n";
     return 2;
   } catch (const std::exception& ex) {
-    std::cerr << "validate-geometry: error: " << ex.what() << "\n";
+    std::cerr << "validate-geometry: error: " << where(ex.what()) << "\n";
     return 2;
   }
 }
