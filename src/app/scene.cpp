@@ -97,7 +97,14 @@ void validate(const Scene& s) {
       throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" would collide with the figures (*.png)");
   }
   if (s.name.empty()) throw std::invalid_argument("name must not be empty");
-  if (s.bounce.enabled) validate(s.bounce);
+  if (s.bounce.enabled) {
+    validate(s.bounce);
+    for (std::size_t i = 0; i < s.bounce.variants.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (s.bounce.variants[i] == s.bounce.variants[j])
+          throw std::invalid_argument("experiment.variants: \"" + std::string(to_string(s.bounce.variants[i])) +
+                                      "\" is given twice (a variant compared with itself decides nothing)");
+  }
   if (s.bounce.enabled && !s.mesh && s.bounce.omega != Vec3::Zero())
     throw std::invalid_argument("bounce: Omega is for mesh bodies; the sphere's variants start without spin (Sec. V)");
   // Mesh bodies and unequal radii are the runs of body_experiments.hpp (also after command-line

@@ -6,6 +6,7 @@
 #define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -437,7 +438,11 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
         try {
           do {
             const std::size_t comma = v->find(',', pos);
-            s.bounce.variants.push_back(parse_bounce_variant(v->substr(pos, comma - pos)));
+            const BounceVariant b = parse_bounce_variant(v->substr(pos, comma - pos));
+            if (std::find(s.bounce.variants.begin(), s.bounce.variants.end(), b) != s.bounce.variants.end())
+              ex->bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(*v) +
+                                      " (a variant compared with itself decides nothing)");
+            s.bounce.variants.push_back(b);
             pos = comma == std::string::npos ? comma : comma + 1;
           } while (pos != std::string::npos);
         } catch (const std::invalid_argument& err) {
