@@ -372,13 +372,13 @@ void check_scene_inputs(const Scene& s) {
   // |Omega| x bounding radius within the supported range.
   const Vec3 omega = s.bounce.enabled ? s.bounce.omega : s.ensemble.impact.omega;
   const std::string key = "experiment.Omega (--omega-x/--omega-y)";
-  const double surface = omega.norm() * L;
+  const double surface = omega.stableNorm() * L;
   if (!(surface <= kMaxSpeed))
-    throw std::invalid_argument(key + ": |Omega| = " + show(omega.norm()) + " rad/s x " + show(L) +
+    throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
                                 " m (the body's bounding radius) gives a surface speed of " + show(surface) +
                                 " m/s; must be <= " + show(kMaxSpeed) + " m/s (supported range)");
   if (!s.bounce.enabled && !(surface < s.ensemble.impact.speed))
-    throw std::invalid_argument(key + ": |Omega| = " + show(omega.norm()) + " rad/s x " + show(L) +
+    throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
                                 " m (the body's bounding radius; body.scale = " + show(m.scale) +
                                 ") gives a surface speed of " + show(surface) + " m/s, not below the approach speed " +
                                 show(s.ensemble.impact.speed) +

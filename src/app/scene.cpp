@@ -121,6 +121,14 @@ void validate(const Scene& s) {
     if (s.bounce.enabled && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
       throw std::invalid_argument("a mesh body bounces with its orientation carried by the free rotation: variants must "
                                   "be \"dynamic\" only");
+    // Standard errors between bodies (batch means) need two rotations of each: refused before
+    // the run, not found after it.
+    const auto K = s.ensemble.spheres, n = s.ensemble.drops;
+    if (s.ensemble.impact.enabled && K >= 2 && n / K < 2)
+      throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over ensemble.spheres = " +
+                                  std::to_string(K) + " bodies is " + std::to_string(n / K) +
+                                  " rotation per body; the standard errors between bodies need at least 2 (drops >= " +
+                                  std::to_string(2 * K) + ", or fewer --spheres)");
   } else if (s.radii) {
     // As the scene file checks it, also after --radius: every level (the lognormal median) below R.
     const auto& d = s.radii->radii;
@@ -135,6 +143,12 @@ void validate(const Scene& s) {
                                   std::string(to_string(s.ensemble.mode)));
     if (s.ensemble.impact.enabled || s.bounce.enabled)
       throw std::invalid_argument("unequal asperity radii on a sphere are analysed as contacts only (no impacts)");
+    const auto B = s.radii->screen_bodies, n = s.ensemble.drops;
+    if (d.kind == RadiusDistribution::Kind::lognormal && B >= 2 && n / B < 2)
+      throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over screening.bodies = " +
+                                  std::to_string(B) + " (lognormal radii: r_x from rotations of the screened bodies) is " +
+                                  std::to_string(n / B) + " rotation per body; the standard errors between bodies need "
+                                  "at least 2 (drops >= " + std::to_string(2 * B) + ")");
   }
 }
 

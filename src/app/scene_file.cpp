@@ -310,11 +310,17 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
       if (*dist == "fixed") {
         const auto a = rad->positive("value", "m");
         if (!a) rad->missing("value", "the asperity radius a [m]");
+        if (!(*a >= kMinLength && *a <= kMaxLength))
+          rad->bad("value", "must be in [" + num(kMinLength) + ", " + num(kMaxLength) + "] m (supported range), got " +
+                                num(*a));
         if (!s.mesh && *a >= R) rad->bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
         s.ensemble.sphere.asperity_radius = *a;
       } else if (*dist == "lognormal") {
         const auto median = rad->positive("median", "m");
         if (!median) rad->missing("median", "the median asperity radius exp(mu) [m]");
+        if (!(*median >= kMinLength && *median <= kMaxLength))
+          rad->bad("median", "must be in [" + num(kMinLength) + ", " + num(kMaxLength) + "] m (supported range), got " +
+                                 num(*median));
         const auto sigma = rad->real("sigma");
         if (!sigma) rad->missing("sigma", "the standard deviation of ln(radius), e.g. 0.3");
         if (*sigma < 0) rad->bad("sigma", "must be >= 0, got " + num(*sigma));
@@ -323,9 +329,15 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
       } else {
         const auto radii = rad->reals("radii");
         const auto fractions = rad->reals("fractions");
-        if (radii)
+        if (radii) {
           for (double r : *radii)
-            if (!(r > 0)) rad->bad("radii", "every radius must be > 0 m, got " + num(r));
+            if (!(r >= kMinLength && r <= kMaxLength))
+              rad->bad("radii", "every radius must be in [" + num(kMinLength) + ", " + num(kMaxLength) +
+                                    "] m (supported range), got " + num(r));
+          if (radii->size() > kMaxRadiusLevels)
+            rad->bad("radii", "at most " + std::to_string(kMaxRadiusLevels) + " levels, got " +
+                                  std::to_string(radii->size()) + " (the exact level law costs ~levels^3 per point)");
+        }
         if (fractions) {
           double sum = 0;
           for (double f : *fractions) {
@@ -536,10 +548,14 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   top.finish();
 
   // The engine's own checks, as a net: the keys above should already have caught everything.
+  // A message that starts with a dotted key ("ensemble.drops (--drops): ...") points at its line.
   try {
     validate(s);
   } catch (const std::invalid_argument& ex) {
-    top.fail(nullptr, "", ex.what());
+    const std::string what = ex.what();
+    const std::string key = what.substr(0, what.find_first_of(" :"));
+    const toml::node* at = key.find('.') != std::string::npos ? root.at_path(key).node() : nullptr;
+    top.fail(at, at ? key : "", what);
   }
   return s;
 }
