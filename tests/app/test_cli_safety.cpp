@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -64,6 +65,7 @@ bool has_gnuplot() { return std::system("gnuplot -e 'set terminal pngcairo' >/de
 // Starts validate-geometry with default signal dispositions (a shell's `&` would ignore SIGINT),
 // stdout and stderr into `log`.
 pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+  std::fflush(nullptr);  // the child must not repeat our buffered output
   const pid_t pid = ::fork();
   if (pid == 0) {
     for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);

@@ -21,6 +21,7 @@
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/report.hpp"
+#include "asperity/app/resources.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene.hpp"
 #include "app/cli/options.hpp"
@@ -30,28 +31,6 @@ namespace fs = std::filesystem;
 using namespace asperity;
 using asperity::cli::BadInput;
 using asperity::cli::ProgressLine;
-
-namespace {
-
-// Explicit spheres (fixed mode) hold 24 bytes per centre plus the index, one sphere per thread
-// when many small spheres run in parallel; per-drop samples take ~50 bytes. A run that cannot fit
-// in physical memory is refused up front, naming the value, instead of dying in the OOM killer.
-void check_memory(const EnsembleConfig& e) {
-  const double pages = double(::sysconf(_SC_PHYS_PAGES)), page = double(::sysconf(_SC_PAGESIZE));
-  if (!(pages > 0 && page > 0)) return;  // unknown: let the allocation decide
-  const double ram = pages * page;
-  double need = 64.0 * double(e.drops);
-  if (e.mode == Mode::fixed) need += 2.0 * 24.0 * double(e.sphere.asperities);  // centres + index, at least
-  if (need > ram) {
-    std::ostringstream os;
-    os << "--asperities " << e.sphere.asperities << " with --drops " << e.drops << " (" << to_string(e.mode)
-       << " mode) needs at least " << std::setprecision(3) << need / 1e9 << " GB, more than this machine's "
-       << ram / 1e9 << " GB";
-    throw BadInput(os.str());
-  }
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   // First, before any thread exists: SIGINT/SIGTERM/SIGHUP/SIGPIPE remove this run's temporaries
@@ -72,7 +51,7 @@ int main(int argc, char** argv) {
     if (scene.plots && !plotting_available())
       throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
     check_scene_inputs(scene);
-    check_memory(scene.ensemble);
+    check_memory(scene);
   } catch (const std::exception& ex) {
     std::cerr << "validate-geometry: error: " << ex.what() << "\n";
     return 2;
