@@ -405,7 +405,7 @@ std::string_view to_string(RunKind k) {
 
 SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log,
                              const std::filesystem::path& dir) {
-  validate(s);
+  check_scene_inputs(s);  // validate(s), and a mesh body's derived quantities, before any file is written
 #ifdef _OPENMP
   if (s.ensemble.threads > 0) omp_set_num_threads(s.ensemble.threads);  // as run_contact_ensemble does
 #endif

@@ -252,6 +252,13 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
           body->bad("smooth", "expected [a, b, c] or [a, b, c, m] [m], got " + std::to_string(sm->size()) + " numbers");
         for (std::size_t i = 0; i < sm->size(); ++i)
           if (!((*sm)[i] > 0)) body->bad("smooth", "element " + std::to_string(i) + " must be > 0, got " + num((*sm)[i]));
+        // The supported lengths (geometry.hpp); check_scene_inputs (run.hpp) also matches them to the mesh.
+        for (std::size_t i = 0; i < 3; ++i)
+          if (!((*sm)[i] >= kMinLength && (*sm)[i] <= kMaxLength))
+            body->bad("smooth", "semi-axis " + std::to_string(i) + " must be in [" + num(kMinLength) + ", " +
+                                    num(kMaxLength) + "] m (supported range), got " + num((*sm)[i]));
+        if (sm->size() == 4 && !((*sm)[3] >= 2 && (*sm)[3] <= kMaxSuperellipsoidExponent))
+          body->bad("smooth", "exponent m must be in [2, " + num(kMaxSuperellipsoidExponent) + "], got " + num((*sm)[3]));
         m.smooth = *sm;
       }
       if (body->has("radius")) body->bad("radius", "only for kind = \"sphere\" (a mesh body's size is the mesh x scale)");

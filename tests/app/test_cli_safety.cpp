@@ -233,3 +233,126 @@ TEST(CliOutput, AFullDiskSaysNoSpaceLeft) {
 }
 
 }  // namespace
+
+namespace {
+
+struct Refusal {
+  std::string args;       // command-line arguments (a scene file's text replaces @SCENE@)
+  std::string scene;      // the scene file, if any
+  std::string must_say;
+};
+
+std::string mesh_scene(const std::string& body_extra, const std::string& extra = "") {
+  return "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"" + std::string(SCENES_DIR) + "/../meshes/ellipsoid.off\"\n" +
+         body_extra + "[asperities]\ncount = 500\n" + extra +
+         "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 100\n"
+         "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n[outputs]\nplots = false\n";
+}
+
+std::string mesh_bounce_scene() {
+  return "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"" + std::string(SCENES_DIR) + "/../meshes/ellipsoid.off\"\n"
+         "[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\nspheres = 2\n"
+         "[experiment]\nkind = \"bounce\"\nspeed = 0.5\nstop_speed = 0.2\nsequences = 2\n[outputs]\nplots = false\n";
+}
+
+// Items 5-10, 12, 13: what cannot run, or would run to nonsense, is refused before the output
+// directory is touched (exit 2), naming the key or option and the value.
+TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
+  const std::vector<Refusal> cases = {
+      // 5: a mesh's smooth surface, scale, exponent (exit 134 or nonsense before)
+      {"", mesh_scene("smooth = [1e300, 1e300, 1e300]\n"), "body.smooth: semi-axis x = 1e+300"},
+      {"", mesh_scene("smooth = [1e150, 1e150, 1e150]\n"), "body.smooth"},
+      {"", mesh_scene("smooth = [1e-9, 1e-9, 1e-9]\n"), "body.smooth"},
+      {"", mesh_scene("smooth = [4e-3, 3e-3, 2.25e-3, 2000]\n"), "body.smooth: exponent m = 2000"},
+      {"", mesh_scene("scale = 1e6\n"), "body.scale = 1e+06"},
+      {"", mesh_scene("scale = 1e9\n"), "body.scale"},
+      {"", mesh_scene("scale = 1e-9\n"), "asperities.radius"},
+      // 6: one spin rule for every body
+      {"--omega-x 1e300", mesh_bounce_scene(), "experiment.Omega (--omega-x/--omega-y)"},
+      {"--omega-y 1e12", mesh_bounce_scene(), "surface speed of 4e+09 m/s"},
+      {"--omega-y 1e12 --speed 1", "", "spin"},
+      // 7: radii below the supported range
+      {"", "format = 1\n[asperities]\ncount = 2000\nradius = { distribution = \"lognormal\", median = 1e-300, sigma = 0.3 }\n",
+       "asperities.radius.median: must be in [1e-15, 1e+06] m"},
+      {"", "format = 1\n[asperities]\ncount = 2000\nradius = { distribution = \"levels\", radii = [1e-300, 6.5e-7], "
+           "fractions = [0.5, 0.5] }\n",
+       "asperities.radius.radii"},
+      // 8: output names
+      {"", "format = 1\n[outputs]\nreport = \"r_xy.png\"\n", "outputs.report"},
+      {"", mesh_scene("", "") + "export_ply = \"report.json\"\n", "outputs.export_ply"},
+      {"", mesh_scene("", "") + "export_ply = \"report.txt\"\n", "outputs.export_ply"},
+      {"", "format = 1\n[outputs]\nreport = \"a\\u0000b.json\"\n", "control character"},
+      {"", "format = 1\n[outputs]\nreport = \"sub/r.json\"\n", "outputs.report"},
+      // 9: duplicate variants
+      {"--preset fig6 --variant paper,paper", "", "--variant: 'paper' is given twice"},
+      {"", "format = 1\n[experiment]\nkind = \"bounce\"\nvariants = \"dynamic,paper,dynamic\"\n", "experiment.variants"},
+      // 10: integers as integers
+      {"--seed \" -5\"", "", "--seed: ' -5'"},
+      {"--asperities 0x10", "", "--asperities: '0x10'"},
+      {"--asperities +16", "", "--asperities: '+16'"},
+      {"--asperities \" 16\"", "", "--asperities: ' 16'"},
+      {"--asperities 9007199254740993", "", "'9007199254740993' must be <= 4294967295"},
+      {"--out= --no-plots", "", "--out: ''"},
+      // 12: one rotation per body; radius levels capped
+      {"--drops 2 --spheres 2", mesh_scene(""), "ensemble.drops (--drops)"},
+      {"", "format = 1\n[asperities]\ncount = 2000\nradius = { distribution = \"levels\", radii = [" +
+               [] {
+                 std::string r;
+                 for (int i = 0; i < 17; ++i) r += (i ? ", " : "") + std::to_string(6.5e-7 * (1 + i / 17.0));
+                 return r;
+               }() +
+               "], fractions = [" +
+               [] {
+                 std::string f;
+                 for (int i = 0; i < 17; ++i) f += (i ? ", " : "") + std::string(i < 16 ? "0.0625" : "0.0");
+                 return f;
+               }() +
+               "] }\n",
+       "at most 16 levels"},
+      // 13: numbers out of range are numbers; ranges name the option or key
+      {"--alpha 4.9e-324", "", "--alpha: '4.9e-324' is out of range"},
+      {"--asperities 1e-400", "", "--asperities: '1e-400' must be a whole number"},
+      {"--asperities 5000000000", "", "--asperities: '5000000000' must be <= 4294967295"},
+      {"", "format = 1\n[ensemble]\nthreads = 2000\n", ":3: ensemble.threads: must be <= 1024"},
+      {"--foo 1 --bar 2", "", "not expected: --foo 1 --bar 2"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = fresh_dir("refused");
+    std::string args = c.args;
+    fs::path scene;
+    if (!c.scene.empty()) {
+      scene = out.string() + ".toml";
+      std::ofstream(scene) << c.scene;
+      args = "--scene " + scene.string() + " " + args;
+    }
+    const auto r = run_command(vg() + " -q " + args + " --out " + out.string() + " 2>&1");
+    EXPECT_EQ(r.status, 2) << args << "\n" << c.scene << r.out;
+    EXPECT_NE(r.out.find(c.must_say), std::string::npos) << args << "\n" << c.scene << "did not say: " << c.must_say
+                                                         << "\n" << r.out;
+    EXPECT_FALSE(fs::exists(out)) << args << ": the output directory was touched";
+    if (!scene.empty()) fs::remove(scene);
+    fs::remove_all(out);
+    fs::remove_all("--no-plots");  // the old parser made it the output directory
+  }
+}
+
+// Item 13: a mesh body's asperity radius is checked against the body, not the unused sphere
+// radius: 0.01 m runs on the ellipsoid scaled x10 (semi-axes 40, 30, 22.5 mm).
+TEST(CliRefusals, MeshAsperityRadiusIsCheckedAgainstTheBody) {
+  const fs::path out = fresh_dir("mesh-radius");
+  const fs::path scene = out.string() + ".toml";
+  std::ofstream(scene) << mesh_scene("scale = 10\n", "radius = { distribution = \"fixed\", value = 0.01 }\n");
+  auto r = run_command(vg() + " -q --scene " + scene.string() + " --omega-x 0.01 --out " + out.string() + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::exists(out / "report.json"));
+  fs::remove_all(out);
+  std::ofstream(scene) << mesh_scene("", "radius = { distribution = \"fixed\", value = 0.01 }\n");
+  r = run_command(vg() + " -q --scene " + scene.string() + " --out " + out.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("smallest half-extent 0.00225 m"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("radius (0.003 m)"), std::string::npos) << r.out;
+  fs::remove(scene);
+  fs::remove_all(out);
+}
+
+}  // namespace

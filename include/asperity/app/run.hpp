@@ -18,9 +18,6 @@ namespace asperity {
 /// the scene as TOML (to_toml(s)). Throws std::invalid_argument for an invalid scene.
 GeometryReport run_scene(const Scene& s, const Progress& progress = {}, const std::filesystem::path& dir = {});
 
-/// Largest exponent m of a superellipsoid body.smooth = [a, b, c, m] (|x/a|^m must stay finite).
-inline constexpr double kMaxSuperellipsoidExponent = 100;
-
 /// validate(s), then what needs the files a scene refers to: a mesh body's mesh is read and its
 /// derived quantities checked against the supported ranges (size, mass and inertia, asperity
 /// radius below the body's smallest half-extent, body.smooth against the mesh, the spin's

@@ -32,6 +32,9 @@ struct MeshBodyScene {
   friend bool operator==(const MeshBodyScene&, const MeshBodyScene&) = default;
 };
 
+/// Largest exponent m of a superellipsoid body.smooth = [a, b, c, m] (|x/a|^m must stay finite).
+inline constexpr double kMaxSuperellipsoidExponent = 100;
+
 /// Unequal asperity radii on the sphere: a run of run_radii_experiment (body_experiments.hpp).
 struct RadiiScene {
   RadiusDistribution radii;                  ///< levels or lognormal
