@@ -61,6 +61,8 @@ std::string fmt(double v) {
   return os.str();
 }
 
+std::string count(std::uint64_t v) { return std::to_string(v); }
+
 std::string gb(double bytes) { return fmt(bytes / 1e9) + " GB"; }
 
 }  // namespace
@@ -77,7 +79,7 @@ MemoryEstimate estimate_memory(const Scene& s) {
       double per_drop = pe.mode == Mode::fresh ? kPerDropFresh : kPerDropFixed;
       if (pe.impact.enabled) per_drop = kPerDropImpact;
       m.bytes = kBaseSphere + per_drop * n;
-      d << fmt(n) << " drops x " << per_drop << " B";
+      d << count(e.drops) << " drops x " << per_drop << " B";
       if (pe.mode == Mode::fixed) {
         // Few large batches: one sphere at a time; many small spheres: one per busy thread, each
         // thread taking 4 spheres at a time (ensemble.cpp).
@@ -88,20 +90,20 @@ MemoryEstimate estimate_memory(const Scene& s) {
                 : double(std::min<std::uint64_t>(std::uint64_t(threads_of(s)), (e.spheres + 3) / 4));
         const double b = per_asperity(pe.backend);
         m.bytes += concurrent * N * b;
-        d << " + " << fmt(concurrent) << " sphere(s) at once (--threads " << threads_of(s) << ") x " << fmt(N)
+        d << " + " << fmt(concurrent) << " sphere(s) at once (--threads " << threads_of(s) << ") x " << count(e.sphere.asperities)
           << " asperities x " << b << " B (" << to_string(pe.backend) << ")";
       }
       break;
     }
     case RunKind::radii: {
       m.bytes = kBaseSphere + kPerDropFresh * n + N * per_asperity(Backend::grid);
-      d << fmt(n) << " drops x " << kPerDropFresh << " B + one screened sphere of " << fmt(N) << " asperities x "
+      d << count(e.drops) << " drops x " << kPerDropFresh << " B + one screened sphere of " << count(e.sphere.asperities) << " asperities x "
         << per_asperity(Backend::grid) << " B";
       break;
     }
     case RunKind::mesh: {
       m.bytes = kBaseMesh + kPerDropMesh * n + kPerAsperityMesh * N;
-      d << fmt(n) << " drops x " << kPerDropMesh << " B + one body at a time of " << fmt(N) << " asperities x "
+      d << count(e.drops) << " drops x " << kPerDropMesh << " B + one body at a time of " << count(e.sphere.asperities) << " asperities x "
         << kPerAsperityMesh << " B";
       break;
     }
@@ -110,7 +112,7 @@ MemoryEstimate estimate_memory(const Scene& s) {
       const double impacts = kImpactsPerDecade * std::log10(s.bounce.speed / s.bounce.stop_speed);
       const double seq = double(s.bounce.sequences);
       m.bytes = kBaseMesh + K * N * kPerAsperityMesh + seq * impacts * kPerImpactBounce;
-      d << fmt(K) << " bodies kept x " << fmt(N) << " asperities x " << kPerAsperityMesh << " B + " << fmt(seq)
+      d << count(e.spheres) << " bodies kept x " << count(e.sphere.asperities) << " asperities x " << kPerAsperityMesh << " B + " << count(s.bounce.sequences)
         << " sequences x ~" << fmt(impacts) << " impacts x " << kPerImpactBounce << " B";
       break;
     }
@@ -121,7 +123,7 @@ MemoryEstimate estimate_memory(const Scene& s) {
       const double seq = double(s.bounce.sequences);
       const double variants = 1.0 + (double(s.bounce.variants.size()) - 1.0) / 6.0;
       m.bytes = kBaseSphere + seq * impacts * kPerImpactBounce * variants;
-      d << fmt(seq) << " sequences x ~" << fmt(impacts) << " impacts x " << kPerImpactBounce << " B x " << fmt(variants)
+      d << count(s.bounce.sequences) << " sequences x ~" << fmt(impacts) << " impacts x " << kPerImpactBounce << " B x " << fmt(variants)
         << " (variants)";
       break;
     }

@@ -258,7 +258,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
             body->bad("smooth", "semi-axis " + std::to_string(i) + " must be in [" + num(kMinLength) + ", " +
                                     num(kMaxLength) + "] m (supported range), got " + num((*sm)[i]));
         if (sm->size() == 4 && !((*sm)[3] >= 2 && (*sm)[3] <= kMaxSuperellipsoidExponent))
-          body->bad("smooth", "exponent m must be in [2, " + num(kMaxSuperellipsoidExponent) + "], got " + num((*sm)[3]));
+          body->bad("smooth", "exponent m must be in [2, " + std::to_string(static_cast<int>(kMaxSuperellipsoidExponent)) + "], got " + num((*sm)[3]));
         m.smooth = *sm;
       }
       if (body->has("radius")) body->bad("radius", "only for kind = \"sphere\" (a mesh body's size is the mesh x scale)");

@@ -260,10 +260,10 @@ std::string mesh_bounce_scene() {
 TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
   const std::vector<Refusal> cases = {
       // 5: a mesh's smooth surface, scale, exponent (exit 134 or nonsense before)
-      {"", mesh_scene("smooth = [1e300, 1e300, 1e300]\n"), "body.smooth: semi-axis x = 1e+300"},
+      {"", mesh_scene("smooth = [1e300, 1e300, 1e300]\n"), "body.smooth: semi-axis 0 must be in [1e-15, 1e+06] m (supported range), got 1e+300"},
       {"", mesh_scene("smooth = [1e150, 1e150, 1e150]\n"), "body.smooth"},
       {"", mesh_scene("smooth = [1e-9, 1e-9, 1e-9]\n"), "body.smooth"},
-      {"", mesh_scene("smooth = [4e-3, 3e-3, 2.25e-3, 2000]\n"), "body.smooth: exponent m = 2000"},
+      {"", mesh_scene("smooth = [4e-3, 3e-3, 2.25e-3, 2000]\n"), "body.smooth: exponent m must be in [2, 100], got 2000"},
       {"", mesh_scene("scale = 1e6\n"), "body.scale = 1e+06"},
       {"", mesh_scene("scale = 1e9\n"), "body.scale"},
       {"", mesh_scene("scale = 1e-9\n"), "asperities.radius"},

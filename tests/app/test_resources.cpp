@@ -88,7 +88,7 @@ TEST(Resources, RunsThatDoNotFitAreRefusedBeforeTheyStart) {
   r = asperity::testing::run_command("ulimit -v 2000000; " + std::string(VALIDATE_GEOMETRY) +
                                      " --mode fixed --asperities 5e7 --drops 1000 --out /nonexistent/never 2>&1");
   EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("5e+07 asperities"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("50000000 asperities"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("2.05 GB this process may use"), std::string::npos) << r.out;
 }
 
