@@ -165,7 +165,11 @@ TEST(CliOutput, SignalsAtRandomPointsLeaveTheOutputCompleteOrUnchanged) {
       const int status = wait_status(pid);
       const auto after = snapshot(out);
       const std::string what = std::string(strsignal(sig)) + " after " + std::to_string(t) + " s: " + slurp(log);
-      if (status == 128 + sig && after == before) {
+      if (status == 1000 + sig && after == before) {
+        // Killed before main() installed the handlers (process start-up, a loaded machine): the
+        // default action, which a shell also reports as 128 + signal; nothing was touched.
+        ++interrupted;
+      } else if (status == 128 + sig && after == before) {
         ++interrupted;
         EXPECT_NE(slurp(log).find("interrupted by"), std::string::npos) << what;
       } else {
