@@ -29,6 +29,7 @@ std::atomic<pid_t> g_child{0};
 std::atomic<int> g_phase{0};    // 0 running, 1 deferred (renaming into place), 2 aborting
 std::atomic<int> g_pending{0};  // a signal that arrived while deferred
 std::atomic<bool> g_installed{false};
+std::atomic<bool> g_committed{false};  // the run's files are in place: nothing of it to remove
 const char* g_program = "asperity";
 
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
@@ -100,7 +101,8 @@ void wipe_dir(const char* path) {
   put(g_program);
   put(": interrupted by ");
   put(signal_name(sig));
-  put(": this run's temporary files were removed\n");
+  put(g_committed.load() ? ": the run had completed; its files are in place\n"
+                         : ": this run's temporary files were removed, the output directory is as it was\n");
   ::_exit(128 + sig);
 }
 
@@ -166,6 +168,7 @@ InterruptCleanup::~InterruptCleanup() {
 }
 
 void set_interrupt_child(pid_t pgid) { g_child.store(pgid); }
+void set_interrupt_output_committed() { g_committed.store(true); }
 void clear_interrupt_child() { g_child.store(0); }
 
 InterruptDeferral::InterruptDeferral() {

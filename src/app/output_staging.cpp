@@ -144,6 +144,7 @@ std::vector<fs::path> OutputStaging::commit() {
       done.push_back(target);
     }
     committed_ = true;
+    set_interrupt_output_committed();
     std::error_code ec;
     fs::remove_all(dir_, ec);
   }

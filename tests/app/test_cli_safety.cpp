@@ -360,3 +360,22 @@ TEST(CliRefusals, MeshAsperityRadiusIsCheckedAgainstTheBody) {
 }
 
 }  // namespace
+
+namespace {
+
+// Item 3: `validate-geometry ... | true` (the reader goes away): the table is printed after the
+// files are in place, so the run is complete and exits 141 (128 + SIGPIPE) saying so.
+TEST(CliOutput, AClosedPipeAfterTheRunKeepsItsCompleteOutput) {
+  const fs::path out = fresh_dir("pipe");
+  const std::string plots = has_gnuplot() ? "" : " --no-plots";
+  const auto r = run_command("bash -c '" + vg() + " --asperities 1000 --drops 2000" + plots + " --out " + out.string() +
+                             " 2>" + out.string() + ".err | true; echo status=${PIPESTATUS[0]}'");
+  EXPECT_NE(r.out.find("status=141"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(out / "report.json") && fs::exists(out / "report.txt")) << r.out;
+  if (plots.empty()) EXPECT_TRUE(complete(snapshot(out)));
+  EXPECT_NE(slurp(out.string() + ".err").find("the run had completed; its files are in place"), std::string::npos);
+  fs::remove_all(out);
+  fs::remove(out.string() + ".err");
+}
+
+}  // namespace

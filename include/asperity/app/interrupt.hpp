@@ -36,6 +36,9 @@ class InterruptCleanup {
 void set_interrupt_child(pid_t pgid);
 void clear_interrupt_child();
 
+/// The run's files are in place (OutputStaging::commit): a later signal says so.
+void set_interrupt_output_committed();
+
 /// A critical section that a signal must not interrupt (renaming a run's files into place):
 /// while it lives, a signal is only recorded; when it ends, a recorded signal is handled (clean-up
 /// of what is still registered, exit 128 + signal). If a signal is already being handled when it
