@@ -372,7 +372,9 @@ TEST(CliOutput, AClosedPipeAfterTheRunKeepsItsCompleteOutput) {
                              " 2>" + out.string() + ".err | true; echo status=${PIPESTATUS[0]}'");
   EXPECT_NE(r.out.find("status=141"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(out / "report.json") && fs::exists(out / "report.txt")) << r.out;
-  if (plots.empty()) EXPECT_TRUE(complete(snapshot(out)));
+  if (plots.empty()) {
+    EXPECT_TRUE(complete(snapshot(out)));
+  }
   EXPECT_NE(slurp(out.string() + ".err").find("the run had completed; its files are in place"), std::string::npos);
   fs::remove_all(out);
   fs::remove(out.string() + ".err");
