@@ -1,11 +1,19 @@
 // Histogram-vs-theory figures drawn by gnuplot (pngcairo). The script and its inline data go to a
 // private temporary directory, gnuplot renders to a temporary file beside the target, and the
 // result is renamed onto the target only when gnuplot succeeded: a failure never leaves a partial
-// PNG, and temporaries are always removed.
+// PNG, and temporaries are always removed (also on a signal: interrupt.hpp). gnuplot runs as a
+// child in its own process group (posix_spawn, no shell), so a signal to us is not blocked while
+// it runs (as system() would) and the handler kills it.
 #include "asperity/app/plot.hpp"
 
+#include <signal.h>
+#include <spawn.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <fcntl.h>
+
+#include <cerrno>
 
 #include <algorithm>
 #include <cctype>
@@ -23,21 +31,14 @@
 #include <system_error>
 #include <vector>
 
+#include "asperity/app/interrupt.hpp"
+
+extern char** environ;
+
 namespace asperity {
 namespace fs = std::filesystem;
 
 namespace {
-
-/// Quote for a POSIX shell: '...' with embedded ' written as '\''.
-std::string shell_quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
-  }
-  out += '\'';
-  return out;
-}
 
 /// A gnuplot single-quoted string (no backslash processing; ' is doubled). Used for paths.
 std::string gp_path(const fs::path& p) {
@@ -68,10 +69,66 @@ std::string gp_text(const std::string& s) {
   return out;
 }
 
-/// Runs a shell command; true when it exited normally with status 0.
-bool run_ok(const std::string& cmd) {
-  const int rc = std::system(cmd.c_str());
-  return rc != -1 && WIFEXITED(rc) && WEXITSTATUS(rc) == 0;
+/// Runs gnuplot with `args` (no shell), stdin and stdout on /dev/null, stderr into `err_file`
+/// (or /dev/null), in its own process group, registered for the interrupt handler. True when it
+/// exited normally with status 0; `spawn_error` gets errno when it could not be started.
+bool run_gnuplot_process(const std::vector<std::string>& args, const fs::path& err_file, int* spawn_error = nullptr) {
+  posix_spawn_file_actions_t fa;
+  posix_spawnattr_t at;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawnattr_init(&at);
+  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 2, err_file.empty() ? "/dev/null" : err_file.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  sigset_t none, defaults;
+  sigemptyset(&none);
+  sigemptyset(&defaults);
+  for (int sg : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT}) sigaddset(&defaults, sg);
+  posix_spawnattr_setsigmask(&at, &none);
+  posix_spawnattr_setsigdefault(&at, &defaults);
+  posix_spawnattr_setpgroup(&at, 0);  // its own group: the terminal's ^C reaches us, we kill it
+  posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawnp(&pid, argv[0], &fa, &at, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  posix_spawnattr_destroy(&at);
+  if (rc != 0) {
+    if (spawn_error) *spawn_error = rc;
+    return false;
+  }
+  set_interrupt_child(pid);
+  int status = 0;
+  pid_t w;
+  do {
+    w = ::waitpid(pid, &status, 0);
+  } while (w == -1 && errno == EINTR);
+  clear_interrupt_child();
+  return w == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+/// " (no space left on device: N bytes free)" when the file system of `dir` is (nearly) full.
+std::string space_note(const fs::path& dir) {
+  struct statvfs v {};
+  if (::statvfs(dir.empty() ? "." : dir.c_str(), &v) != 0) return "";
+  const double free_bytes = double(v.f_bavail) * double(v.f_frsize);
+  if (free_bytes >= 1024.0 * 1024.0) return "";
+  return ": no space left on device (" + std::to_string(static_cast<long long>(free_bytes)) + " bytes free in " +
+         (dir.empty() ? std::string(".") : dir.string()) + ")";
+}
+
+/// The first lines of gnuplot's messages (a full disk makes two screens of warnings).
+std::string first_lines(const std::string& text, int lines = 6) {
+  std::size_t pos = 0;
+  for (int i = 0; i < lines; ++i) {
+    pos = text.find('\n', pos);
+    if (pos == std::string::npos) return text;
+    ++pos;
+  }
+  return text.substr(0, pos) + "... (more gnuplot messages not shown)";
 }
 
 std::string random_suffix() {
@@ -269,7 +326,7 @@ std::string build_script(const HistogramFigure& fig, const fs::path& out) {
 
 
 bool plotting_available() {
-  return run_ok("gnuplot -e \"set terminal pngcairo\" >/dev/null 2>&1 </dev/null");
+  return run_gnuplot_process({"gnuplot", "-e", "set terminal pngcairo"}, {});
 }
 
 namespace {
@@ -293,6 +350,7 @@ void run_gnuplot(const char* who, const fs::path& png, const std::function<std::
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
   if (stem.size() > 64) stem.resize(64);
   const fs::path work = tmp_root / ("asperity-plot-" + stem + "-" + suffix);
+  const InterruptCleanup work_on_signal(work);  // registered before it exists
   if (!fs::create_directory(work, ec) || ec)
     throw std::runtime_error(w + ": cannot create " + work.string() +
                              (ec ? ": " + ec.message() : std::string(": already exists")));
@@ -300,6 +358,7 @@ void run_gnuplot(const char* who, const fs::path& png, const std::function<std::
 
   // Gnuplot renders beside the target so the final rename is atomic (same filesystem).
   const fs::path out = png.parent_path() / (png.filename().string() + "." + suffix + ".tmp");
+  const InterruptCleanup out_on_signal(out, InterruptCleanup::Kind::file);
   cleanup.paths.push_back(out);
 
   const fs::path script = work / "figure.gp";
@@ -309,20 +368,26 @@ void run_gnuplot(const char* who, const fs::path& png, const std::function<std::
     std::ofstream f(script, std::ios::binary);
     f << text;
     f.close();
-    if (!f) throw std::runtime_error(w + ": cannot write " + script.string());
+    if (!f) throw std::runtime_error(w + ": cannot write " + script.string() + space_note(work));
   }
 
-  const std::string cmd =
-      "gnuplot " + shell_quote(script.string()) + " </dev/null >/dev/null 2>" + shell_quote(err.string());
-  const bool ok = run_ok(cmd);
-  const std::string messages = read_file_text(err);
-  if (!ok)
-    throw std::runtime_error(w + ": gnuplot failed writing " + png.string() +
-                             (messages.empty() ? std::string(" (no message; is gnuplot installed?)")
-                                               : ":\n" + messages));
-  if (!fs::is_regular_file(out, ec) || fs::file_size(out, ec) == 0 || ec)
+  int spawn_error = 0;
+  const bool ok = run_gnuplot_process({"gnuplot", script.string()}, err, &spawn_error);
+  const std::string messages = first_lines(read_file_text(err));
+  if (spawn_error != 0)
+    throw std::runtime_error(w + ": cannot run gnuplot: " + std::generic_category().message(spawn_error) +
+                             " (is gnuplot installed? scripts/setup)");
+  const bool produced = fs::is_regular_file(out, ec) && fs::file_size(out, ec) > 0 && !ec;
+  if (!ok || !produced) {
+    // A full disk explains itself; gnuplot's warnings would only hide it.
+    if (const std::string full = space_note(png.parent_path()); !full.empty())
+      throw std::runtime_error(w + ": cannot write " + png.string() + full);
+    if (!ok)
+      throw std::runtime_error(w + ": gnuplot failed writing " + png.string() +
+                               (messages.empty() ? std::string(" (no message)") : ":\n" + messages));
     throw std::runtime_error(w + ": gnuplot produced no output for " + png.string() +
                              (messages.empty() ? std::string() : ":\n" + messages));
+  }
 
   fs::rename(out, png, ec);
   if (ec) throw std::runtime_error(w + ": cannot rename onto " + png.string() + ": " + ec.message());

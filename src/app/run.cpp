@@ -5,17 +5,21 @@
 #endif
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <filesystem>
 #include <optional>
 #include <ostream>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
+
 #include "asperity/experiments/body_bounce.hpp"
 #include "asperity/experiments/body_experiments.hpp"
 #include "asperity/experiments/bounce.hpp"
 #include "asperity/app/experiment_reports.hpp"
 #include "asperity/app/mesh_io.hpp"
+#include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/scene_file.hpp"
 
@@ -101,19 +105,19 @@ PlanStage export_stage(const Scene& s, double seconds) {
 }
 
 // The first body of a mesh scene (same seed and index as the run's body 0) as PLY.
-void export_first_body(const Scene& s, const TriangleMesh& mesh) {
+void export_first_body(const Scene& s, const TriangleMesh& mesh, const std::filesystem::path& dir) {
   const double density = s.ensemble.impact.density;
   const RoughBody b = make_rough_mesh_body(mesh, s.ensemble.sphere.asperities, scene_radii(s), density, s.ensemble.seed, 0,
                                            smooth_surface(s.mesh->smooth), s.mesh->file.stem().string());
-  write_ply(s.out / s.mesh->export_ply, b, s.mesh->export_points ? PlyStyle::points : PlyStyle::spheres, 1.0, &mesh,
+  write_ply(dir / s.mesh->export_ply, b, s.mesh->export_points ? PlyStyle::points : PlyStyle::spheres, 1.0, &mesh,
             -mass_properties(mesh, density).centroid);
 }
 
-SceneOutput run_radii(const Scene& s, const Progress& progress) {
+SceneOutput run_radii(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
   RadiiReport r = run_radii_experiment(radii_experiment(s), progress);
   if (s.plots) {
     const auto t0 = Clock::now();
-    r.plots = write_figures(s.out, r.figures);
+    r.plots = write_figures(dir, r.figures);
     r.seconds_plots = since(t0);
   }
   const bool lognormal = s.radii->radii.kind == RadiusDistribution::Kind::lognormal;
@@ -138,7 +142,7 @@ SceneOutput run_radii(const Scene& s, const Progress& progress) {
   return o;
 }
 
-SceneOutput run_mesh(const Scene& s, const Progress& progress) {
+SceneOutput run_mesh(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
   const MeshImpactExperiment m = mesh_experiment(s);
   const TriangleMesh mesh = read_mesh(m.mesh, m.scale);
   SceneOutput o;
@@ -146,13 +150,13 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress) {
   if (!s.mesh->export_ply.empty()) {
     const auto t0 = Clock::now();
     o.files.push_back(s.mesh->export_ply);  // listed first: removed if anything below fails
-    export_first_body(s, mesh);
+    export_first_body(s, mesh, dir);
     seconds_export = since(t0);
   }
   MeshImpactReport r = run_mesh_impacts(m, mesh, progress);
   if (s.plots) {
     const auto t0 = Clock::now();
-    r.plots = write_figures(s.out, r.figures);
+    r.plots = write_figures(dir, r.figures);
     r.seconds_plots = since(t0);
   }
   o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
@@ -172,7 +176,7 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress) {
   return o;
 }
 
-SceneOutput run_bounce(const Scene& s, std::ostream* log) {
+SceneOutput run_bounce(const Scene& s, std::ostream* log, const std::filesystem::path& dir) {
   const auto& e = s.ensemble;
   SceneOutput o;
   auto t0 = Clock::now();
@@ -188,7 +192,7 @@ SceneOutput run_bounce(const Scene& s, std::ostream* log) {
   const double seconds_analysis = since(t0);
   t0 = Clock::now();
   std::vector<std::string> plots;
-  if (s.plots) plots = write_bounce_plots(s.out, reports);
+  if (s.plots) plots = write_bounce_plots(dir, reports);
   o.files = plots;
   const double seconds_plots = since(t0);
   o.table = table.str();
@@ -200,7 +204,7 @@ SceneOutput run_bounce(const Scene& s, std::ostream* log) {
   return o;
 }
 
-SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
+SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
   const auto& e = s.ensemble;
   MeshBounceExperiment m;
   m.mesh = s.mesh->file;
@@ -222,13 +226,13 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
   if (!s.mesh->export_ply.empty()) {
     const auto t0 = Clock::now();
     o.files.push_back(s.mesh->export_ply);
-    export_first_body(s, *mesh);
+    export_first_body(s, *mesh, dir);
     seconds_export = since(t0);
   }
   MeshBounceReport r = run_mesh_bounces(m, mesh ? &*mesh : nullptr, progress);
   if (s.plots) {
     const auto t0 = Clock::now();
-    r.plots = write_mesh_bounce_plots(s.out, r);
+    r.plots = write_mesh_bounce_plots(dir, r);
     r.seconds_plots = since(t0);
   }
   o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
@@ -247,8 +251,8 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress) {
   return o;
 }
 
-SceneOutput run_sphere(const Scene& s, const Progress& progress) {
-  const GeometryReport r = run_scene(s, progress);
+SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
+  const GeometryReport r = run_scene(s, progress, dir);
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
@@ -266,7 +270,7 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress) {
 
 }  // namespace
 
-GeometryReport run_scene(const Scene& s, const Progress& progress) {
+GeometryReport run_scene(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
   validate(s);
   Plan plan = make_plan(s);
   const Scene& run = plan.scene;
@@ -277,7 +281,7 @@ GeometryReport run_scene(const Scene& s, const Progress& progress) {
   plan.stage("analysis").seconds = r.timings_s.back().second;
   if (plan.runs("plots")) {
     t0 = Clock::now();
-    r.plots = write_plots(run.out, run, samples);
+    r.plots = write_plots(dir.empty() ? run.out : dir, run, samples);
     r.timings_s.emplace_back("plots", since(t0));
     plan.stage("plots").seconds = r.timings_s.back().second;
   }
@@ -288,6 +292,99 @@ GeometryReport run_scene(const Scene& s, const Progress& progress) {
   r.plan = std::move(plan.stages);
   r.scene_toml = to_toml(s);
   return r;
+}
+
+namespace {
+
+// The largest asperity radius a scene can draw (levels: the largest; lognormal: the median).
+double top_radius(const Scene& s) {
+  if (!s.radii) return s.ensemble.sphere.asperity_radius;
+  const auto& d = s.radii->radii;
+  switch (d.kind) {
+    case RadiusDistribution::Kind::levels: return *std::max_element(d.levels.begin(), d.levels.end());
+    case RadiusDistribution::Kind::lognormal: return d.median;
+    case RadiusDistribution::Kind::fixed: return d.radius;
+  }
+  return d.radius;
+}
+
+std::string show(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
+}
+
+}  // namespace
+
+void check_scene_inputs(const Scene& s) {
+  validate(s);
+  if (!s.mesh) return;
+  const auto& m = *s.mesh;
+  TriangleMesh mesh;
+  try {
+    mesh = read_mesh(m.file, m.scale);
+  } catch (const std::exception& ex) {
+    throw std::invalid_argument("body.mesh: " + std::string(ex.what()));
+  }
+  if (mesh.vertices.empty() || mesh.faces.empty())
+    throw std::invalid_argument("body.mesh: " + m.file.string() + " has no triangles");
+  const double density = s.ensemble.impact.density;
+  MassProperties mp;
+  try {
+    mp = mass_properties(mesh, density);
+  } catch (const std::exception& ex) {
+    throw std::invalid_argument("body.mesh: " + m.file.string() + " x body.scale = " + show(m.scale) + ": " + ex.what());
+  }
+  // The body's size: its bounding radius about the centre of mass and its half-extents along
+  // the mesh axes (where asperity centres and the smooth surface live).
+  double L = 0;
+  Vec3 half = Vec3::Zero();
+  for (const auto& v : mesh.vertices) {
+    L = std::max(L, (v - mp.centroid).norm());
+    half = half.cwiseMax(v.cwiseAbs());
+  }
+  const double thinnest = half.minCoeff();
+  const std::string size = "the body (" + m.file.filename().string() + " x body.scale = " + show(m.scale) +
+                           ") has a bounding radius of " + show(L) + " m";
+  if (!(std::isfinite(L) && L <= kMaxLength))
+    throw std::invalid_argument("body.scale: " + size + "; supported: <= " + show(kMaxLength) + " m");
+  const Eigen::Vector3d moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(mp.inertia).eigenvalues();
+  if (!std::isnormal(mp.mass) || !(moments.minCoeff() > 0) || !std::isnormal(moments.minCoeff()) ||
+      !std::isfinite(moments.maxCoeff()))
+    throw std::invalid_argument("body.scale: " + size + " and material.density = " + show(density) +
+                                " kg/m^3 give a mass or moment of inertia outside the range of double");
+  const double a = top_radius(s);
+  if (!(a < thinnest))
+    throw std::invalid_argument("asperities.radius: " + show(a) + " m must be smaller than the body's smallest half-extent " +
+                                show(thinnest) + " m (body.mesh x body.scale)");
+  if (!m.smooth.empty()) {
+    const char* axis = "xyz";
+    for (int i = 0; i < 3; ++i) {
+      const double ax = m.smooth[static_cast<std::size_t>(i)];
+      if (!(ax >= 0.5 * half[i] && ax <= 2.0 * half[i]))
+        throw std::invalid_argument("body.smooth: semi-axis " + std::string(1, axis[i]) + " = " + show(ax) +
+                                    " m must match the mesh (its half-extent along " + std::string(1, axis[i]) + " is " +
+                                    show(half[i]) + " m; supported: 0.5x to 2x)");
+    }
+    if (m.smooth.size() == 4 && !(m.smooth[3] >= 2 && m.smooth[3] <= kMaxSuperellipsoidExponent))
+      throw std::invalid_argument("body.smooth: exponent m = " + show(m.smooth[3]) + " must be in [2, " +
+                                  show(kMaxSuperellipsoidExponent) + "]");
+  }
+  // Spin: one rule for every body, as for the sphere (ensemble.hpp): the surface speed
+  // |Omega| x bounding radius within the supported range.
+  const Vec3 omega = s.bounce.enabled ? s.bounce.omega : s.ensemble.impact.omega;
+  const std::string key = "experiment.Omega (--omega-x/--omega-y)";
+  const double surface = omega.stableNorm() * L;
+  if (!(surface <= kMaxSpeed))
+    throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
+                                " m (the body's bounding radius) gives a surface speed of " + show(surface) +
+                                " m/s; must be <= " + show(kMaxSpeed) + " m/s (supported range)");
+  if (!s.bounce.enabled && !(surface < s.ensemble.impact.speed))
+    throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
+                                " m (the body's bounding radius; body.scale = " + show(m.scale) +
+                                ") gives a surface speed of " + show(surface) + " m/s, not below the approach speed " +
+                                show(s.ensemble.impact.speed) +
+                                " m/s: parts of the body would recede from the plate (supported: |Omega| L < |V.z|)");
 }
 
 RunKind run_kind(const Scene& s) {
@@ -308,36 +405,31 @@ std::string_view to_string(RunKind k) {
   return "?";
 }
 
-SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log) {
-  validate(s);
+SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log,
+                             const std::filesystem::path& dir) {
+  check_scene_inputs(s);  // validate(s), and a mesh body's derived quantities, before any file is written
 #ifdef _OPENMP
   if (s.ensemble.threads > 0) omp_set_num_threads(s.ensemble.threads);  // as run_contact_ensemble does
 #endif
-  // Names the run may write into s.out; whatever exists of them afterwards on failure is its own.
-  namespace fs = std::filesystem;
-  std::vector<fs::path> before;
-  std::error_code ec;
-  if (fs::is_directory(s.out, ec))
-    for (const auto& f : fs::directory_iterator(s.out, ec)) before.push_back(f.path());
-  try {
-    SceneOutput o;
-    switch (run_kind(s)) {
-      case RunKind::sphere: o = run_sphere(s, progress); break;
-      case RunKind::radii: o = run_radii(s, progress); break;
-      case RunKind::mesh: o = run_mesh(s, progress); break;
-      case RunKind::bounce: o = run_bounce(s, log); break;
-      case RunKind::mesh_bounce: o = run_mesh_bounce(s, progress); break;
-    }
-    o.kind = run_kind(s);
-    return o;
-  } catch (...) {
-    // Remove the files that appeared during this run (figures, PLY): no partial output.
-    if (fs::is_directory(s.out, ec))
-      for (const auto& f : fs::directory_iterator(s.out, ec))
-        if (std::find(before.begin(), before.end(), f.path()) == before.end() && f.is_regular_file(ec))
-          fs::remove(f.path(), ec);
-    throw;
+  // Without a directory from the caller the run stages its own files in s.out and renames them
+  // into place at the end: a failure leaves s.out as it was (output_staging.hpp).
+  std::optional<OutputStaging> own;
+  if (dir.empty()) own.emplace(s.out);
+  const std::filesystem::path& into = dir.empty() ? own->dir() : dir;
+  SceneOutput o;
+  switch (run_kind(s)) {
+    case RunKind::sphere: o = run_sphere(s, progress, into); break;
+    case RunKind::radii: o = run_radii(s, progress, into); break;
+    case RunKind::mesh: o = run_mesh(s, progress, into); break;
+    case RunKind::bounce: o = run_bounce(s, log, into); break;
+    case RunKind::mesh_bounce: o = run_mesh_bounce(s, progress, into); break;
   }
+  o.kind = run_kind(s);
+  if (own) {
+    for (const auto& f : o.files) own->add(f);
+    own->commit();
+  }
+  return o;
 }
 
 }  // namespace asperity

@@ -1,9 +1,13 @@
 #include "asperity/app/scene.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <stdexcept>
 
+#include "asperity/app/output_staging.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "core/format.hpp"
 #include "asperity_embedded_scenes.hpp"  // generated from scenes/*.toml (CMakeLists.txt)
@@ -28,15 +32,79 @@ Scene preset(std::string_view name) {
   return parse_scene(preset_text(name), "preset " + std::string(name) + " (scenes/" + std::string(name) + ".toml)");
 }
 
+namespace {
+
+bool ends_with_png(const std::string& name) {
+  if (name.size() < 4) return false;
+  std::string ext = name.substr(name.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".png";
+}
+
+// A name for a message: control characters (a NUL, a newline) shown as \xNN.
+std::string printable(const std::string& name) {
+  std::string out;
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", u);
+      out += buf;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string report_table_name(const std::string& report) {
+  std::filesystem::path txt = report;
+  txt.replace_extension(".txt");
+  if (txt == std::filesystem::path(report)) txt += ".txt";  // a report named "x.txt" keeps its table apart
+  return txt.string();
+}
+
 void validate(const Scene& s) {
-  validate(s.ensemble);
+  if (s.mesh) {
+    // A mesh body's size is its mesh x scale (check_scene_inputs, run.hpp, checks the asperity
+    // radius against it): the sphere radius is unused and must not refuse the asperity radius.
+    EnsembleConfig e = s.ensemble;
+    e.sphere.radius = std::max(e.sphere.radius, 2.0 * e.sphere.asperity_radius);
+    validate(e);
+  } else {
+    validate(s.ensemble);
+  }
   if (!(s.alpha > 0 && s.alpha < 1))
     throw std::invalid_argument("alpha must be in (0, 1), got " + std::to_string(s.alpha));
   if (s.out.empty()) throw std::invalid_argument("out must not be empty");
-  if (s.report.empty() || s.report.find('/') != std::string::npos || s.report == "." || s.report == "..")
-    throw std::invalid_argument("report must be a file name inside out, got '" + s.report + "'");
+  // Output names: plain file names, none the same as another output of the run (the figures are
+  // *.png; the table is the report's name with .txt).
+  if (const std::string why = output_name_problem(s.report); !why.empty())
+    throw std::invalid_argument("outputs.report: \"" + printable(s.report) + "\" " + why);
+  const std::string table = report_table_name(s.report);
+  if (ends_with_png(s.report))
+    throw std::invalid_argument("outputs.report: \"" + s.report + "\" would collide with the figures (*.png)");
+  if (s.mesh && !s.mesh->export_ply.empty()) {
+    const std::string& ply = s.mesh->export_ply;
+    if (const std::string why = output_name_problem(ply); !why.empty())
+      throw std::invalid_argument("outputs.export_ply: \"" + printable(ply) + "\" " + why);
+    if (ply == s.report || ply == table)
+      throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" is also the name of the report" +
+                                  (ply == table ? "'s table (" + s.report + " -> " + table + ")" : std::string()));
+    if (ends_with_png(ply))
+      throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" would collide with the figures (*.png)");
+  }
   if (s.name.empty()) throw std::invalid_argument("name must not be empty");
-  if (s.bounce.enabled) validate(s.bounce);
+  if (s.bounce.enabled) {
+    validate(s.bounce);
+    for (std::size_t i = 0; i < s.bounce.variants.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (s.bounce.variants[i] == s.bounce.variants[j])
+          throw std::invalid_argument("experiment.variants: \"" + std::string(to_string(s.bounce.variants[i])) +
+                                      "\" is given twice (a variant compared with itself decides nothing)");
+  }
   if (s.bounce.enabled && !s.mesh && s.bounce.omega != Vec3::Zero())
     throw std::invalid_argument("bounce: Omega is for mesh bodies; the sphere's variants start without spin (Sec. V)");
   // Mesh bodies and unequal radii are the runs of body_experiments.hpp (also after command-line
@@ -53,6 +121,14 @@ void validate(const Scene& s) {
     if (s.bounce.enabled && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
       throw std::invalid_argument("a mesh body bounces with its orientation carried by the free rotation: variants must "
                                   "be \"dynamic\" only");
+    // Standard errors between bodies (batch means) need two rotations of each: refused before
+    // the run, not found after it.
+    const auto K = s.ensemble.spheres, n = s.ensemble.drops;
+    if (s.ensemble.impact.enabled && K >= 2 && n / K < 2)
+      throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over ensemble.spheres = " +
+                                  std::to_string(K) + " bodies is " + std::to_string(n / K) +
+                                  " rotation per body; the standard errors between bodies need at least 2 (drops >= " +
+                                  std::to_string(2 * K) + ", or fewer --spheres)");
   } else if (s.radii) {
     // As the scene file checks it, also after --radius: every level (the lognormal median) below R.
     const auto& d = s.radii->radii;
@@ -67,6 +143,12 @@ void validate(const Scene& s) {
                                   std::string(to_string(s.ensemble.mode)));
     if (s.ensemble.impact.enabled || s.bounce.enabled)
       throw std::invalid_argument("unequal asperity radii on a sphere are analysed as contacts only (no impacts)");
+    const auto B = s.radii->screen_bodies, n = s.ensemble.drops;
+    if (d.kind == RadiusDistribution::Kind::lognormal && B >= 2 && n / B < 2)
+      throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over screening.bodies = " +
+                                  std::to_string(B) + " (lognormal radii: r_x from rotations of the screened bodies) is " +
+                                  std::to_string(n / B) + " rotation per body; the standard errors between bodies need "
+                                  "at least 2 (drops >= " + std::to_string(2 * B) + ")");
   }
 }
 

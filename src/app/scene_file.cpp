@@ -1,9 +1,12 @@
 // Scene files (format 1). toml++ is used header-only, in this translation unit only.
 #include "asperity/app/scene_file.hpp"
 
+#include "asperity/app/output_staging.hpp"
+
 #define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -283,6 +286,13 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
           body->bad("smooth", "expected [a, b, c] or [a, b, c, m] [m], got " + std::to_string(sm->size()) + " numbers");
         for (std::size_t i = 0; i < sm->size(); ++i)
           if (!((*sm)[i] > 0)) body->bad("smooth", "element " + std::to_string(i) + " must be > 0, got " + num((*sm)[i]));
+        // The supported lengths (geometry.hpp); check_scene_inputs (run.hpp) also matches them to the mesh.
+        for (std::size_t i = 0; i < 3; ++i)
+          if (!((*sm)[i] >= kMinLength && (*sm)[i] <= kMaxLength))
+            body->bad("smooth", "semi-axis " + std::to_string(i) + " must be in [" + num(kMinLength) + ", " +
+                                    num(kMaxLength) + "] m (supported range), got " + num((*sm)[i]));
+        if (sm->size() == 4 && !((*sm)[3] >= 2 && (*sm)[3] <= kMaxSuperellipsoidExponent))
+          body->bad("smooth", "exponent m must be in [2, " + std::to_string(static_cast<int>(kMaxSuperellipsoidExponent)) + "], got " + num((*sm)[3]));
         m.smooth = *sm;
       }
       if (body->has("radius")) body->bad("radius", "only for kind = \"sphere\" (a mesh body's size is the mesh x scale)");
@@ -355,11 +365,17 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
       if (*dist == "fixed") {
         const auto a = rad->positive("value", "m");
         if (!a) rad->missing("value", "the asperity radius a [m]");
+        if (!(*a >= kMinLength && *a <= kMaxLength))
+          rad->bad("value", "must be in [" + num(kMinLength) + ", " + num(kMaxLength) + "] m (supported range), got " +
+                                num(*a));
         if (!s.mesh && *a >= R) rad->bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
         s.ensemble.sphere.asperity_radius = *a;
       } else if (*dist == "lognormal") {
         const auto median = rad->positive("median", "m");
         if (!median) rad->missing("median", "the median asperity radius exp(mu) [m]");
+        if (!(*median >= kMinLength && *median <= kMaxLength))
+          rad->bad("median", "must be in [" + num(kMinLength) + ", " + num(kMaxLength) + "] m (supported range), got " +
+                                 num(*median));
         const auto sigma = rad->real("sigma");
         if (!sigma) rad->missing("sigma", "the standard deviation of ln(radius), e.g. 0.3");
         if (*sigma < 0) rad->bad("sigma", "must be >= 0, got " + num(*sigma));
@@ -368,9 +384,15 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
       } else {
         const auto radii = rad->reals("radii");
         const auto fractions = rad->reals("fractions");
-        if (radii)
+        if (radii) {
           for (double r : *radii)
-            if (!(r > 0)) rad->bad("radii", "every radius must be > 0 m, got " + num(r));
+            if (!(r >= kMinLength && r <= kMaxLength))
+              rad->bad("radii", "every radius must be in [" + num(kMinLength) + ", " + num(kMaxLength) +
+                                    "] m (supported range), got " + num(r));
+          if (radii->size() > kMaxRadiusLevels)
+            rad->bad("radii", "at most " + std::to_string(kMaxRadiusLevels) + " levels, got " +
+                                  std::to_string(radii->size()) + " (the exact level law costs ~levels^3 per point)");
+        }
         if (fractions) {
           double sum = 0;
           for (double f : *fractions) {
@@ -431,7 +453,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
         ens->bad("backend", "only mode = \"fixed\" queries a contact index (fresh mode draws the lowest asperities "
                             "exactly): \"auto\" or absent, got \"" + *b + "\"");
     }
-    if (auto t = ens->count("threads", 0, 4096)) e.threads = static_cast<int>(*t);
+    if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
     ens->finish();
   }
 
@@ -483,7 +505,11 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
         try {
           do {
             const std::size_t comma = v->find(',', pos);
-            s.bounce.variants.push_back(parse_bounce_variant(v->substr(pos, comma - pos)));
+            const BounceVariant b = parse_bounce_variant(v->substr(pos, comma - pos));
+            if (std::find(s.bounce.variants.begin(), s.bounce.variants.end(), b) != s.bounce.variants.end())
+              ex->bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(*v) +
+                                      " (a variant compared with itself decides nothing)");
+            s.bounce.variants.push_back(b);
             pos = comma == std::string::npos ? comma : comma + 1;
           } while (pos != std::string::npos);
         } catch (const std::invalid_argument& err) {
@@ -553,14 +579,17 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     }
     if (auto d = out->text("dir")) s.out = *d;
     if (auto r = out->text("report")) {
-      if (r->find('/') != std::string::npos || *r == "." || *r == "..")
-        out->bad("report", "must be a file name inside outputs.dir, got " + quote(*r));
+      if (const std::string why = output_name_problem(*r); !why.empty())
+        out->bad("report", "must be a plain file name inside outputs.dir, got " + quote(*r) + ": it " + why);
       s.report = *r;
     }
     if (auto p = out->text("export_ply")) {
       if (!s.mesh) out->bad("export_ply", "only for body.kind = \"mesh\"");
-      if (p->find('/') != std::string::npos || *p == "." || *p == "..")
-        out->bad("export_ply", "must be a file name inside outputs.dir, got " + quote(*p));
+      if (const std::string why = output_name_problem(*p); !why.empty())
+        out->bad("export_ply", "must be a plain file name inside outputs.dir, got " + quote(*p) + ": it " + why);
+      if (*p == s.report || *p == report_table_name(s.report))
+        out->bad("export_ply", quote(*p) + " is also the name of the report or its table (" + quote(s.report) + ", " +
+                                   quote(report_table_name(s.report)) + ")");
       s.mesh->export_ply = *p;
     }
     if (auto st = out->choice("export_style", {"spheres", "points"})) {
@@ -574,10 +603,14 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   top.finish();
 
   // The engine's own checks, as a net: the keys above should already have caught everything.
+  // A message that starts with a dotted key ("ensemble.drops (--drops): ...") points at its line.
   try {
     validate(s);
   } catch (const std::invalid_argument& ex) {
-    top.fail(nullptr, "", ex.what());
+    const std::string what = ex.what();
+    const std::string key = what.substr(0, what.find_first_of(" :"));
+    const toml::node* at = key.find('.') != std::string::npos ? root.at_path(key).node() : nullptr;
+    top.fail(at, at ? key : "", what);
   }
   return s;
 }

@@ -53,8 +53,12 @@ std::string RadiusDistribution::describe() const {
 }
 
 void validate(const RadiusDistribution& d) {
+  // The same supported range as the paper's one radius (geometry.hpp), for every radius.
   auto positive = [](double v, const std::string& what) {
     if (!std::isfinite(v) || v <= 0) throw std::invalid_argument(what + " must be a finite number > 0 m, got " + num(v));
+    if (v < kMinLength || v > kMaxLength)
+      throw std::invalid_argument(what + " must be in [" + num(kMinLength) + ", " + num(kMaxLength) +
+                                  "] m (supported range), got " + num(v));
   };
   switch (d.kind) {
     case RadiusDistribution::Kind::fixed: positive(d.radius, "asperity radius"); break;
@@ -65,6 +69,9 @@ void validate(const RadiusDistribution& d) {
       break;
     case RadiusDistribution::Kind::levels: {
       if (d.levels.empty()) throw std::invalid_argument("radius levels: at least one level needed, got none");
+      if (d.levels.size() > kMaxRadiusLevels)
+        throw std::invalid_argument("radius levels: at most " + std::to_string(kMaxRadiusLevels) + " levels, got " +
+                                    std::to_string(d.levels.size()) + " (the exact level law costs ~levels^3 per point)");
       if (d.levels.size() != d.fractions.size())
         throw std::invalid_argument("radius levels: " + std::to_string(d.levels.size()) + " radii but " +
                                     std::to_string(d.fractions.size()) + " fractions");

@@ -1,5 +1,6 @@
 #pragma once
 // One call runs a scene as validate-geometry does: plan, ensemble, analysis, figures.
+#include <filesystem>
 #include <iosfwd>
 #include <string>
 #include <string_view>
@@ -12,10 +13,16 @@
 
 namespace asperity {
 
-/// Runs only the stages make_plan(s) lists (figures are written into s.out when planned; the
-/// report file is not written). The report carries the plan with stage times and the scene as
-/// TOML (to_toml(s)). Throws std::invalid_argument for an invalid scene.
-GeometryReport run_scene(const Scene& s, const Progress& progress = {});
+/// Runs only the stages make_plan(s) lists (figures are written into `dir`, default s.out, when
+/// planned; the report file is not written). The report carries the plan with stage times and
+/// the scene as TOML (to_toml(s)). Throws std::invalid_argument for an invalid scene.
+GeometryReport run_scene(const Scene& s, const Progress& progress = {}, const std::filesystem::path& dir = {});
+
+/// validate(s), then what needs the files a scene refers to: a mesh body's mesh is read and its
+/// derived quantities checked against the supported ranges (size, mass and inertia, asperity
+/// radius below the body's smallest half-extent, body.smooth against the mesh, the spin's
+/// surface speed). Throws std::invalid_argument naming the key. Touches no output.
+void check_scene_inputs(const Scene& s);
 
 /// The kinds of run a scene can be (README "Scenes").
 enum class RunKind {
@@ -33,7 +40,7 @@ struct SceneOutput {
   RunKind kind = RunKind::sphere;
   std::string json;                 ///< report.json text, with the common header (with_header)
   std::string table;                ///< the table for people (printed, and written as report.txt)
-  std::vector<std::string> files;   ///< files the run wrote into s.out (figures, PLY), by name
+  std::vector<std::string> files;   ///< files the run wrote (figures, PLY), by name
   bool rejected = false;            ///< a decisive test rejected its law (exit status 1)
   /// Decisive tests that could not be evaluated (verdict "skipped"), one line each with the
   /// reason; the run still exits 0 unless a law was rejected (README "validate-geometry").
@@ -41,9 +48,12 @@ struct SceneOutput {
 };
 
 /// Runs a scene of any kind and renders its report; writes only figures (and the PLY of a mesh
-/// scene's outputs.export_ply) into s.out, never the report files. Progress of the drops goes to
-/// `progress` (sphere, radii, mesh), one line per bounce variant to `log` if given. On an
-/// exception the files this call wrote are removed.
-SceneOutput run_scene_output(const Scene& s, const Progress& progress = {}, std::ostream* log = nullptr);
+/// scene's outputs.export_ply), never the report files. Progress of the drops goes to
+/// `progress` (sphere, radii, mesh), one line per bounce variant to `log` if given.
+/// `dir` given (validate-geometry: an OutputStaging's dir()): the files are written there under
+/// their final names and the caller commits them. `dir` empty: they are staged in s.out and
+/// renamed into place when the run succeeded; on an exception s.out is left as it was.
+SceneOutput run_scene_output(const Scene& s, const Progress& progress = {}, std::ostream* log = nullptr,
+                             const std::filesystem::path& dir = {});
 
 }  // namespace asperity

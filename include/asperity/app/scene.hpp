@@ -32,6 +32,9 @@ struct MeshBodyScene {
   friend bool operator==(const MeshBodyScene&, const MeshBodyScene&) = default;
 };
 
+/// Largest exponent m of a superellipsoid body.smooth = [a, b, c, m] (|x/a|^m must stay finite).
+inline constexpr double kMaxSuperellipsoidExponent = 100;
+
 /// Unequal asperity radii on the sphere: a run of run_radii_experiment (body_experiments.hpp).
 struct RadiiScene {
   RadiusDistribution radii;                  ///< levels or lognormal
@@ -81,7 +84,13 @@ std::string_view preset_text(std::string_view name);
 ///       V_z < 0.1 m/s, 1e5 sequences per variant (paper, random-orientation, dynamic).
 Scene preset(std::string_view name);
 
-/// Throws std::invalid_argument naming the offending field and value.
+/// Throws std::invalid_argument naming the offending field and value. Output names (report,
+/// export_ply) must be plain file names, distinct from each other, from the report's table
+/// (report_table_name) and from the figures (*.png).
 void validate(const Scene& s);
+
+/// The table's file name next to the report: its name with .txt ("report.json" -> "report.txt";
+/// "x.txt" -> "x.txt.txt").
+std::string report_table_name(const std::string& report);
 
 }  // namespace asperity

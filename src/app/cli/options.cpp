@@ -2,27 +2,66 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <vector>
 
 #include "asperity/app/scene_file.hpp"
-#include <cstdint>
-#include <vector>
 
 namespace asperity::cli {
 
 namespace {
 
-// Every number goes through here: the whole text must parse and be finite.
-double parse_real(const std::string& option, const std::string& text) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;  // not a number, or out of the range of double
+constexpr std::uint64_t kMaxAsperities = (std::uint64_t{1} << 32) - 1;  // geometry.hpp: N < 2^32
+constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
+
+bool digits(const std::string& t, std::size_t& i) {
+  const std::size_t from = i;
+  while (i < t.size() && t[i] >= '0' && t[i] <= '9') ++i;
+  return i > from;
+}
+
+// Plain decimal notation: [sign] digits [. digits] [e [sign] digits] (or [sign] . digits ...).
+// No spaces, no hexadecimal, no "inf"/"nan": what a person writes for a number.
+bool decimal_syntax(const std::string& t) {
+  std::size_t i = 0;
+  if (i < t.size() && (t[i] == '+' || t[i] == '-')) ++i;
+  const bool whole = digits(t, i);
+  bool fraction = false;
+  if (i < t.size() && t[i] == '.') {
+    ++i;
+    fraction = digits(t, i);
   }
-  if (text.empty() || used != text.size()) throw BadInput(option + ": '" + text + "' is not a number");
-  if (!std::isfinite(v)) throw BadInput(option + ": '" + text + "' must be finite");
+  if (!whole && !fraction) return false;
+  if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
+    ++i;
+    if (i < t.size() && (t[i] == '+' || t[i] == '-')) ++i;
+    if (!digits(t, i)) return false;
+  }
+  return i == t.size();
+}
+
+bool names_infinity_or_nan(std::string t) {
+  for (char& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!t.empty() && (t[0] == '+' || t[0] == '-')) t.erase(0, 1);
+  return t == "inf" || t == "infinity" || t == "nan";
+}
+
+// Every real number goes through here: the whole text must be a decimal number whose value is a
+// finite, normal double (or zero); out-of-range numbers are named as such, not as "not a number".
+double parse_real(const std::string& option, const std::string& text) {
+  if (names_infinity_or_nan(text)) throw BadInput(option + ": '" + text + "' must be finite");
+  if (!decimal_syntax(text)) throw BadInput(option + ": '" + text + "' is not a number");
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (std::isinf(v)) throw BadInput(option + ": '" + text + "' is out of range (larger than 1.8e308)");
+  if ((errno == ERANGE && v == 0) || std::fpclassify(v) == FP_SUBNORMAL)
+    throw BadInput(option + ": '" + text + "' is out of range (its magnitude is below 2.2e-308, the smallest normal double)");
   return v;
 }
 
@@ -32,13 +71,59 @@ double parse_positive(const std::string& option, const std::string& text, const 
   return v;
 }
 
-// Counts may be written as integers or in exact scientific notation ("1e5").
-std::uint64_t parse_count(const std::string& option, const std::string& text, double min = 1) {
-  const double v = parse_real(option, text);
-  if (v < min) throw BadInput(option + ": '" + text + "' must be >= " + (min == 0 ? "0" : "1"));
-  if (v != std::floor(v)) throw BadInput(option + ": '" + text + "' must be a whole number");
-  if (v > 9.007199254740992e15) throw BadInput(option + ": '" + text + "' is too large");
-  return static_cast<std::uint64_t>(v);
+std::string bound_text(std::uint64_t v) {
+  std::string s = std::to_string(v);
+  for (int k = 16; k < 64; ++k) {
+    const std::uint64_t p = std::uint64_t{1} << k;
+    if (v == p) return s + " (2^" + std::to_string(k) + ")";
+    if (v == p - 1) return s + " (2^" + std::to_string(k) + " - 1)";
+  }
+  if (v == ~std::uint64_t{0}) return s + " (2^64 - 1)";
+  return s;
+}
+
+// Counts are integers: digits, or exact scientific notation ("1e5", "2.5e3"); no sign, spaces,
+// hexadecimal or rounding. The value must lie in [lo, hi], named in the message.
+std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lo, std::uint64_t hi) {
+  const std::string got = option + ": '" + text + "' ";
+  const bool negative = !text.empty() && text[0] == '-';
+  if (names_infinity_or_nan(text)) throw BadInput(got + "must be a finite whole number");
+  if (!decimal_syntax(text) || text[0] == '+')
+    throw BadInput(got + "is not a whole number (write digits, e.g. 1000 or 1e3)");
+  if (negative) throw BadInput(got + "must be >= " + std::to_string(lo));
+  // Exact: mantissa digits x 10^exponent.
+  std::string mant;
+  long long exp10 = 0;
+  std::size_t i = 0;
+  for (; i < text.size() && text[i] != 'e' && text[i] != 'E'; ++i) {
+    if (text[i] == '.') continue;
+    mant += text[i];
+  }
+  const std::size_t dot = text.find('.');
+  const std::size_t epos = text.find_first_of("eE");
+  if (dot != std::string::npos) exp10 -= static_cast<long long>((epos == std::string::npos ? text.size() : epos) - dot - 1);
+  if (epos != std::string::npos) {
+    const std::string e = text.substr(epos + 1);
+    if (e.size() > 6) throw BadInput(got + (e[0] == '-' ? "must be a whole number >= " + std::to_string(lo) : "is too large: must be <= " + bound_text(hi)));
+    exp10 += std::stoll(e);
+  }
+  mant.erase(0, std::min(mant.find_first_not_of('0'), mant.size()));
+  if (mant.empty()) mant = "0";
+  while (exp10 < 0 && mant.size() > 1 && mant.back() == '0') mant.pop_back(), ++exp10;
+  if (mant == "0") exp10 = 0;
+  if (exp10 < 0) throw BadInput(got + "must be a whole number");
+  if (static_cast<long long>(mant.size()) + exp10 > 20) throw BadInput(got + "is too large: must be <= " + bound_text(hi));
+  constexpr std::uint64_t kMax = ~std::uint64_t{0};
+  std::uint64_t v = 0;
+  auto push = [&](unsigned d) {
+    if (v > (kMax - d) / 10) throw BadInput(got + "is too large: must be <= " + bound_text(hi));
+    v = v * 10 + d;
+  };
+  for (char c : mant) push(static_cast<unsigned>(c - '0'));
+  for (long long k = 0; k < exp10; ++k) push(0);
+  if (v > hi) throw BadInput(got + "must be <= " + bound_text(hi));
+  if (v < lo) throw BadInput(got + "must be >= " + std::to_string(lo));
+  return v;
 }
 
 }  // namespace
@@ -76,6 +161,14 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   app.add_flag("--quiet,-q", quiet, "print no progress");
 
   Options o;
+  // "--out=" (nothing after '='): CLI11 would take the next argument as the value.
+  for (const auto& a : args) {
+    if (a == "--") break;
+    if (a.size() > 3 && a.compare(0, 2, "--") == 0 && a.back() == '=' && a.find('=') == a.size() - 1)
+      throw BadInput(a.substr(0, a.size() - 1) + ": '' (an empty value after '=') is not a value; write " +
+                     a.substr(0, a.size() - 1) + "=VALUE or " + a.substr(0, a.size() - 1) + " VALUE");
+  }
+  app.allow_extras();
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 consumes from the back
     app.parse(reversed);
@@ -86,6 +179,12 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   } catch (const CLI::ParseError& e) {
     throw BadInput(std::string(e.what()) + "\nRun with --help for more information.");
   }
+  if (auto extra = app.remaining(); !extra.empty()) {
+    // Listed as the user wrote them (CLI11's own message lists them backwards: we parse reversed).
+    std::string list;
+    for (const auto& x : extra) list += " " + x;
+    throw BadInput("The following arguments were not expected:" + list + "\nRun with --help for more information.");
+  }
 
   try {
     // Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
@@ -95,7 +194,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     // Options override the file (README "Scenes"). An option that cannot apply to the scene's
     // kind of run is an error naming it and why, never silently ignored.
     auto refuse = [](const std::string& option, const std::string& why) { throw BadInput(option + ": " + why); };
-    if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities);
+    if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities, 1, kMaxAsperities);
     if (given("--radius")) {
       const double r = parse_positive("--radius", radius);
       if (scene.mesh)
@@ -118,7 +217,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
                                                           : "levels") +
                                           "\")";
     if (given("--drops")) {
-      e.drops = parse_count("--drops", drops);
+      e.drops = parse_count("--drops", drops, 1, kMaxDrops);
       if (bounce) refuse("--drops", "not used by " + kind + ", which counts bounce sequences: use --sequences");
     }
     if (given("--mode")) {
@@ -133,23 +232,14 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
                          "\"fresh\" (or give --asperity-radius for the paper's equal radii)");
     }
     if (given("--spheres")) {
-      e.spheres = parse_count("--spheres", spheres);
+      e.spheres = parse_count("--spheres", spheres, 1, kMaxDrops);
       if ((bounce && !mesh) || radii)
         refuse("--spheres", "not used by " + kind + (radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
       if (!mesh && e.mode != Mode::fixed)
         refuse("--spheres", "only for fixed mode (explicit spheres x rotations); fresh mode draws a new sphere per drop: "
                             "add --mode fixed");
     }
-    if (given("--seed")) {
-      std::size_t used = 0;
-      try {
-        e.seed = std::stoull(seed, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (seed.empty() || used != seed.size() || seed.front() == '-')
-        throw BadInput("--seed: '" + seed + "' is not a non-negative integer");
-    }
+    if (given("--seed")) e.seed = parse_count("--seed", seed, 0, ~std::uint64_t{0});
     if (given("--speed")) {
       const double u = parse_positive("--speed", speed, "m/s");
       if (radii) refuse("--speed", kind + " is analysed as contacts only (no impacts)");
@@ -184,21 +274,23 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
       throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
     if (scene.bounce.enabled) {
       if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
-      if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", sequences);
+      if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", sequences, 1, kMaxDrops);
       if (given("--variant")) {
         scene.bounce.variants.clear();
         std::size_t pos = 0;
         do {
           const std::size_t comma = variants.find(',', pos);
-          scene.bounce.variants.push_back(parse_bounce_variant(variants.substr(pos, comma - pos)));
+          const BounceVariant v = parse_bounce_variant(variants.substr(pos, comma - pos));
+          if (std::find(scene.bounce.variants.begin(), scene.bounce.variants.end(), v) != scene.bounce.variants.end())
+            throw BadInput("--variant: '" + std::string(to_string(v)) + "' is given twice in '" + variants +
+                           "' (a variant compared with itself decides nothing)");
+          scene.bounce.variants.push_back(v);
           pos = comma == std::string::npos ? comma : comma + 1;
         } while (pos != std::string::npos);
       }
     }
     if (given("--threads")) {
-      const std::uint64_t t = parse_count("--threads", threads, 0);
-      if (t > std::uint64_t(kMaxThreads))
-        throw BadInput("--threads: '" + threads + "' must be <= " + std::to_string(kMaxThreads));
+      const std::uint64_t t = parse_count("--threads", threads, 0, std::uint64_t(kMaxThreads));
       e.threads = static_cast<int>(t);
     }
     if (given("--alpha")) {

@@ -17,8 +17,11 @@
 #include <string>
 #include <vector>
 
+#include "asperity/app/interrupt.hpp"
+#include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/report.hpp"
+#include "asperity/app/resources.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene.hpp"
 #include "app/cli/options.hpp"
@@ -29,43 +32,13 @@ using namespace asperity;
 using asperity::cli::BadInput;
 using asperity::cli::ProgressLine;
 
-namespace {
-
-// Creates the directory if needed and proves it writable before any work starts.
-void prepare_output(const fs::path& dir) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir)) throw BadInput("--out: cannot create directory '" + dir.string() + "'");
-  const fs::path probe = dir / (".write-test." + std::to_string(::getpid()));
-  std::FILE* f = std::fopen(probe.c_str(), "w");
-  if (!f) throw BadInput("--out: directory '" + dir.string() + "' is not writable");
-  std::fclose(f);
-  fs::remove(probe, ec);
-}
-
-// Explicit spheres (fixed mode) hold 24 bytes per centre plus the index, one sphere per thread
-// when many small spheres run in parallel; per-drop samples take ~50 bytes. A run that cannot fit
-// in physical memory is refused up front, naming the value, instead of dying in the OOM killer.
-void check_memory(const EnsembleConfig& e) {
-  const double pages = double(::sysconf(_SC_PHYS_PAGES)), page = double(::sysconf(_SC_PAGESIZE));
-  if (!(pages > 0 && page > 0)) return;  // unknown: let the allocation decide
-  const double ram = pages * page;
-  double need = 64.0 * double(e.drops);
-  if (e.mode == Mode::fixed) need += 2.0 * 24.0 * double(e.sphere.asperities);  // centres + index, at least
-  if (need > ram) {
-    std::ostringstream os;
-    os << "--asperities " << e.sphere.asperities << " with --drops " << e.drops << " (" << to_string(e.mode)
-       << " mode) needs at least " << std::setprecision(3) << need / 1e9 << " GB, more than this machine's "
-       << ram / 1e9 << " GB";
-    throw BadInput(os.str());
-  }
-}
-
-}  // namespace
-
 int main(int argc, char** argv) {
+  // First, before any thread exists: SIGINT/SIGTERM/SIGHUP/SIGPIPE remove this run's temporaries
+  // (its staging directory, gnuplot's files, the directories it created) and exit 128 + signal.
+  install_interrupt_cleanup("validate-geometry");
   Scene scene;
   bool quiet = false;
+  // Everything that can be checked is checked before the output directory is touched.
   try {
     const std::vector<std::string> args(argv + 1, argv + argc);
     const cli::Options o = cli::parse_command_line(args);
@@ -77,8 +50,8 @@ int main(int argc, char** argv) {
     quiet = o.quiet;
     if (scene.plots && !plotting_available())
       throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
-    check_memory(scene.ensemble);
-    prepare_output(scene.out);
+    check_scene_inputs(scene);
+    check_memory(scene);
   } catch (const std::exception& ex) {
     std::cerr << "validate-geometry: error: " << ex.what() << "\n";
     return 2;
@@ -86,23 +59,39 @@ int main(int argc, char** argv) {
 
   // Every kind of run (sphere, unequal radii, mesh body, bounce) ends in the same report path:
   // run_scene_output renders the report with the common header, write_report_files writes it.
-  std::vector<fs::path> written;
-  auto remove_written = [&] {
-    std::error_code ec;
-    for (const auto& p : written) fs::remove(p, ec);
+  // Every file goes into a staging directory inside the output directory and is renamed into
+  // place only when the whole run succeeded (the report last): a failed or interrupted run
+  // leaves the directory as it found it (output_staging.hpp).
+  std::string staging_dir;  // messages name the files where they were going, not the staging copy
+  auto where = [&](std::string message) {
+    for (std::size_t at; !staging_dir.empty() && (at = message.find(staging_dir)) != std::string::npos;)
+      message.replace(at, staging_dir.size(), scene.out.string());
+    return message;
   };
   try {
+    std::optional<OutputStaging> staging;
+    try {
+      staging.emplace(scene.out);
+    } catch (const std::exception& ex) {
+      throw BadInput(std::string("--out: ") + ex.what());
+    }
+    staging_dir = staging->dir().string();
     const bool sequences = run_kind(scene) == RunKind::mesh_bounce || run_kind(scene) == RunKind::bounce;
     ProgressLine progress(!quiet, stderr, ::isatty(2) != 0, &ProgressLine::steady_seconds, 1.0,
                           sequences ? "sequences" : "drops");
-    const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &std::cerr);
+    const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &std::cerr, staging->dir());
     progress.finish();
-    for (const auto& f : r.files) written.push_back(scene.out / f);
+    for (const auto& f : r.files) staging->add(f);
+    const auto reports = write_report_files(staging->dir(), scene.report, r.json, r.table);
+    staging->add(reports.at(1).filename().string());  // the table, then the report last
+    staging->add(reports.at(0).filename().string());
+    staging->commit();
+    staging.reset();
     std::cout << r.table;
-    for (const auto& p : write_report_files(scene.out, scene.report, r.json, r.table)) written.push_back(p);
-    std::cout << "wrote " << (scene.out / scene.report).string() << ", " << written.back().filename().string();
+    std::cout << "wrote " << (scene.out / scene.report).string() << ", " << reports.at(1).filename().string();
     for (const auto& f : r.files) std::cout << ", " << f;
     std::cout << "\n";
+    std::cout.flush();
     // A decisive law that could not be evaluated decides nothing: the exit status stays 0 (no law
     // was rejected), but it must not pass unnoticed. Warned even with --quiet (it is no progress).
     if (!r.skipped.empty()) {
@@ -113,13 +102,12 @@ int main(int argc, char** argv) {
     }
     return r.rejected ? 1 : 0;
   } catch (const std::bad_alloc&) {
-    remove_written();
     std::cerr << "validate-geometry: error: out of memory for " << scene.ensemble.sphere.asperities << " asperities x "
-              << scene.ensemble.drops << " drops (" << to_string(scene.ensemble.mode) << " mode)\n";
+              << scene.ensemble.drops << " drops (" << to_string(scene.ensemble.mode) << " mode); "
+              << scene.out.string() << " is as it was\n";
     return 2;
   } catch (const std::exception& ex) {
-    remove_written();
-    std::cerr << "validate-geometry: error: " << ex.what() << "\n";
+    std::cerr << "validate-geometry: error: " << where(ex.what()) << "\n";
     return 2;
   }
 }

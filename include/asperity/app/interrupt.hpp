@@ -1,0 +1,54 @@
+#pragma once
+// What a run leaves behind when it is interrupted: nothing. install_interrupt_cleanup() makes
+// SIGINT, SIGTERM, SIGHUP and SIGPIPE kill the registered child process group (gnuplot), remove
+// the registered temporary directories (their files, then themselves) and the registered output
+// directories the run created (only if empty), and exit with status 128 + signal number. The
+// handler uses async-signal-safe system calls only; registration is lock-free. Without
+// install_interrupt_cleanup() (a library user) registrations cost a few stores and do nothing.
+#include <sys/types.h>
+
+#include <filesystem>
+
+namespace asperity {
+
+/// Installs the handlers (once; later calls change nothing). `program` prefixes the one line
+/// written to stderr on a signal ("<program>: interrupted by SIGINT; ...").
+void install_interrupt_cleanup(const char* program);
+
+/// A path removed on a signal while the guard lives. Register it BEFORE creating it.
+class InterruptCleanup {
+ public:
+  enum class Kind {
+    directory,        ///< its files, then itself (a staging directory, gnuplot's private directory)
+    empty_directory,  ///< only if empty (a directory the run created for its output)
+    file              ///< a temporary file
+  };
+  explicit InterruptCleanup(const std::filesystem::path& path, Kind kind = Kind::directory);
+  ~InterruptCleanup();
+  InterruptCleanup(const InterruptCleanup&) = delete;
+  InterruptCleanup& operator=(const InterruptCleanup&) = delete;
+
+ private:
+  int slot_ = -1;  ///< -1: no free slot (too many at once): not cleaned on a signal
+};
+
+/// The process group of a running child (gnuplot in its own group): killed on a signal.
+void set_interrupt_child(pid_t pgid);
+void clear_interrupt_child();
+
+/// The run's files are in place (OutputStaging::commit): a later signal says so.
+void set_interrupt_output_committed();
+
+/// A critical section that a signal must not interrupt (renaming a run's files into place):
+/// while it lives, a signal is only recorded; when it ends, a recorded signal is handled (clean-up
+/// of what is still registered, exit 128 + signal). If a signal is already being handled when it
+/// is constructed, the constructor never returns (the handler is about to end the process).
+class InterruptDeferral {
+ public:
+  InterruptDeferral();
+  ~InterruptDeferral();
+  InterruptDeferral(const InterruptDeferral&) = delete;
+  InterruptDeferral& operator=(const InterruptDeferral&) = delete;
+};
+
+}  // namespace asperity

@@ -1,0 +1,190 @@
+#include "asperity/app/interrupt.hpp"
+
+#include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+
+namespace asperity {
+
+namespace {
+
+constexpr int kSlots = 64;
+
+struct Slot {
+  std::atomic<int> state{0};  // 0 free, 2 being written, 1 registered
+  InterruptCleanup::Kind kind = InterruptCleanup::Kind::directory;
+  char path[PATH_MAX] = {};
+};
+
+Slot g_slots[kSlots];
+std::atomic<pid_t> g_child{0};
+std::atomic<int> g_phase{0};    // 0 running, 1 deferred (renaming into place), 2 aborting
+std::atomic<int> g_pending{0};  // a signal that arrived while deferred
+std::atomic<bool> g_installed{false};
+std::atomic<bool> g_committed{false};  // the run's files are in place: nothing of it to remove
+const char* g_program = "asperity";
+
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+
+void put(const char* s) {
+  std::size_t n = 0;
+  while (s[n]) ++n;
+  while (n > 0) {
+    const ssize_t w = ::write(2, s, n);
+    if (w <= 0) return;
+    s += w;
+    n -= static_cast<std::size_t>(w);
+  }
+}
+
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    case SIGPIPE: return "SIGPIPE";
+  }
+  return "a signal";
+}
+
+// Removes the entries of `path` (files; one level) and then the directory, with system calls only
+// (getdents64, unlinkat, rmdir: async-signal-safe). A file created meanwhile by another thread is
+// caught by the next pass.
+void wipe_dir(const char* path) {
+  for (int pass = 0; pass < 4; ++pass) {
+    const int fd = ::open(path, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+    if (fd < 0) return;
+    alignas(8) char buf[4096];
+    for (;;) {
+      const long n = ::syscall(SYS_getdents64, fd, buf, sizeof buf);
+      if (n <= 0) break;
+      for (long off = 0; off < n;) {
+        // struct linux_dirent64: u64 ino, s64 off, u16 reclen, u8 type, char name[]
+        std::uint16_t reclen = 0;
+        std::memcpy(&reclen, buf + off + 16, sizeof reclen);
+        const char* name = buf + off + 19;
+        if (!(name[0] == '.' && (name[1] == 0 || (name[1] == '.' && name[2] == 0)))) ::unlinkat(fd, name, 0);
+        if (reclen == 0) break;
+        off += reclen;
+      }
+    }
+    ::close(fd);
+    if (::rmdir(path) == 0 || errno != ENOTEMPTY) return;
+  }
+}
+
+[[noreturn]] void clean_up_and_exit(int sig) {
+  const pid_t child = g_child.load();
+  if (child > 0) {
+    ::kill(-child, SIGKILL);
+    ::waitpid(child, nullptr, 0);  // may find it reaped already (ECHILD): it is gone either way
+  }
+  using Kind = InterruptCleanup::Kind;
+  for (auto& s : g_slots)
+    if (s.state.load() == 1 && s.kind == Kind::file) ::unlink(s.path);
+  for (auto& s : g_slots)
+    if (s.state.load() == 1 && s.kind == Kind::directory) wipe_dir(s.path);
+  // Directories the run created for its output, deepest first: registered parent first, so
+  // backwards; removed only when empty.
+  for (int i = kSlots - 1; i >= 0; --i)
+    if (g_slots[i].state.load() == 1 && g_slots[i].kind == Kind::empty_directory) ::rmdir(g_slots[i].path);
+  for (int i = kSlots - 1; i >= 0; --i)
+    if (g_slots[i].state.load() == 1 && g_slots[i].kind == Kind::empty_directory) ::rmdir(g_slots[i].path);
+  put(g_program);
+  put(": interrupted by ");
+  put(signal_name(sig));
+  put(g_committed.load() ? ": the run had completed; its files are in place\n"
+                         : ": this run's temporary files were removed, the output directory is as it was\n");
+  ::_exit(128 + sig);
+}
+
+[[noreturn]] void wait_for_exit() {
+  for (;;) ::pause();
+}
+
+void on_signal(int sig) {
+  int expected = 0;
+  if (g_phase.compare_exchange_strong(expected, 2)) clean_up_and_exit(sig);
+  if (expected == 1) {
+    int none = 0;
+    g_pending.compare_exchange_strong(none, sig);
+    return;
+  }
+  wait_for_exit();  // another thread is handling a signal and ends the process
+}
+
+}  // namespace
+
+void install_interrupt_cleanup(const char* program) {
+  if (g_installed.exchange(true)) return;
+  g_program = program;
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  for (int s : kSignals) sigaddset(&sa.sa_mask, s);
+  sa.sa_flags = 0;
+  for (int s : kSignals) {
+    struct sigaction old {};
+    ::sigaction(s, nullptr, &old);
+    // A signal ignored by whoever started us (nohup, `trap '' INT`) stays ignored.
+    if (old.sa_handler == SIG_IGN && s != SIGPIPE) continue;
+    ::sigaction(s, &sa, nullptr);
+  }
+  // Unblock them in this thread; threads created later inherit the mask.
+  sigset_t set;
+  sigemptyset(&set);
+  for (int s : kSignals) sigaddset(&set, s);
+  ::pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
+}
+
+InterruptCleanup::InterruptCleanup(const std::filesystem::path& path, Kind kind) {
+  const std::string& p = path.native();
+  if (p.empty() || p.size() >= PATH_MAX) return;
+  if (g_phase.load() == 2) wait_for_exit();
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (!g_slots[i].state.compare_exchange_strong(expected, 2)) continue;
+    std::memcpy(g_slots[i].path, p.c_str(), p.size() + 1);
+    g_slots[i].kind = kind;
+    g_slots[i].state.store(1);
+    slot_ = i;
+    break;
+  }
+  // A handler that started before the slot was visible did not see it: do not create the
+  // directory, wait for the handler to end the process.
+  if (g_phase.load() == 2) wait_for_exit();
+}
+
+InterruptCleanup::~InterruptCleanup() {
+  if (slot_ >= 0) g_slots[slot_].state.store(0);
+}
+
+void set_interrupt_child(pid_t pgid) { g_child.store(pgid); }
+void set_interrupt_output_committed() { g_committed.store(true); }
+void clear_interrupt_child() { g_child.store(0); }
+
+InterruptDeferral::InterruptDeferral() {
+  int expected = 0;
+  if (!g_phase.compare_exchange_strong(expected, 1)) wait_for_exit();
+}
+
+InterruptDeferral::~InterruptDeferral() {
+  int deferred = 1;
+  g_phase.compare_exchange_strong(deferred, 0);
+  const int sig = g_pending.exchange(0);
+  if (sig != 0) {
+    int expected = 0;
+    if (g_phase.compare_exchange_strong(expected, 2)) clean_up_and_exit(sig);
+    wait_for_exit();
+  }
+}
+
+}  // namespace asperity

@@ -1,0 +1,154 @@
+#include "asperity/app/output_staging.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <system_error>
+
+namespace asperity {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string reason(int err) { return std::generic_category().message(err); }
+
+std::string random_suffix() {
+  std::random_device rd;
+  std::ostringstream s;
+  s << ::getpid() << '-' << std::hex << rd();
+  return s.str();
+}
+
+}  // namespace
+
+std::string output_name_problem(std::string_view name) {
+  if (name.empty()) return "is empty";
+  if (name == "." || name == "..") return "is not a file name";
+  if (name.size() > 255) return "is longer than 255 bytes";
+  for (const char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '/') return "must be a plain file name (no '/')";
+    if (u < 0x20 || u == 0x7f) return "contains a control character (NUL, newline, ...)";
+  }
+  if (name.substr(0, kStagingPrefix.size()) == kStagingPrefix) return "starts with the staging prefix " + std::string(kStagingPrefix);
+  return "";
+}
+
+OutputStaging::OutputStaging(const fs::path& out) : out_(out) {
+  if (out.empty()) throw std::runtime_error("output directory: empty name");
+  // The missing directories, outermost first: each is created (and remembered) in turn.
+  std::vector<fs::path> missing;
+  fs::path p = out.lexically_normal();
+  if (!p.has_filename()) p = p.parent_path();  // "a/b/" -> "a/b"
+  while (!p.empty()) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0 || errno != ENOENT) break;  // exists, or let mkdir say why
+    missing.push_back(p);
+    const fs::path parent = p.parent_path();
+    if (parent == p) break;
+    p = parent;
+  }
+  std::reverse(missing.begin(), missing.end());
+  for (const auto& d : missing) {
+    guards_.push_back(std::make_unique<InterruptCleanup>(d, InterruptCleanup::Kind::empty_directory));
+    if (::mkdir(d.c_str(), 0777) != 0 && errno != EEXIST) {
+      const int err = errno;
+      throw std::runtime_error("cannot create directory '" + d.string() + "': " + reason(err));
+    }
+    created_.push_back(d);
+  }
+  struct stat st {};
+  if (::stat(out.c_str(), &st) != 0) {
+    const int err = errno;
+    throw std::runtime_error("cannot create directory '" + out.string() + "': " + reason(err));
+  }
+  if (!S_ISDIR(st.st_mode)) throw std::runtime_error("'" + out.string() + "' is not a directory");
+  dir_ = out / (std::string(kStagingPrefix) + random_suffix());
+  guards_.push_back(std::make_unique<InterruptCleanup>(dir_));
+  if (::mkdir(dir_.c_str(), 0700) != 0) {
+    const int err = errno;
+    throw std::runtime_error("cannot write into directory '" + out.string() + "': " + reason(err));
+  }
+}
+
+OutputStaging::~OutputStaging() {
+  std::error_code ec;
+  fs::remove_all(dir_, ec);
+  if (!committed_)
+    for (auto it = created_.rbegin(); it != created_.rend(); ++it) ::rmdir(it->c_str());
+}
+
+void OutputStaging::add(const std::string& name) {
+  if (const std::string why = output_name_problem(name); !why.empty())
+    throw std::invalid_argument("output name \"" + name + "\" " + why);
+  if (std::find(names_.begin(), names_.end(), name) != names_.end())
+    throw std::invalid_argument("two outputs of this run are named \"" + name + "\"");
+  struct stat st {};
+  if (::lstat((dir_ / name).c_str(), &st) != 0 || !S_ISREG(st.st_mode))
+    throw std::runtime_error("output \"" + name + "\" was not written into " + dir_.string());
+  names_.push_back(name);
+}
+
+std::vector<fs::path> OutputStaging::commit() {
+  // Nothing moves unless every target can be replaced: a regular file or nothing.
+  for (const auto& n : names_) {
+    const fs::path target = out_ / n;
+    struct stat st {};
+    if (::lstat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      throw std::runtime_error("cannot write " + target.string() + ": " + reason(S_ISDIR(st.st_mode) ? EISDIR : EEXIST) +
+                               " (it is not a regular file; nothing was changed in " + out_.string() + ")");
+  }
+  struct Moved {
+    fs::path target, backup;  // backup empty: the target did not exist before
+  };
+  std::vector<Moved> moved;
+  auto roll_back = [&] {
+    for (auto it = moved.rbegin(); it != moved.rend(); ++it) {
+      if (it->backup.empty()) ::unlink(it->target.c_str());
+      else ::rename(it->backup.c_str(), it->target.c_str());
+    }
+  };
+  std::vector<fs::path> done;
+  {
+    const InterruptDeferral no_signals;  // all renames, or none (a signal waits for the end)
+    for (std::size_t i = 0; i < names_.size(); ++i) {
+      const fs::path from = dir_ / names_[i], target = out_ / names_[i];
+      Moved m{target, {}};
+      struct stat st {};
+      if (::lstat(target.c_str(), &st) == 0) {
+        // Keep the previous file until the whole commit succeeded (a hard link: the target stays).
+        m.backup = dir_ / (".previous." + std::to_string(i));
+        if (::link(target.c_str(), m.backup.c_str()) != 0) {
+          const int err = errno;
+          roll_back();
+          throw std::runtime_error("cannot replace " + target.string() + ": " + reason(err) + " (nothing was changed in " +
+                                   out_.string() + ")");
+        }
+      }
+      if (::rename(from.c_str(), target.c_str()) != 0) {
+        const int err = errno;
+        if (!m.backup.empty()) ::unlink(m.backup.c_str());
+        roll_back();
+        throw std::runtime_error("cannot write " + target.string() + ": " + reason(err) + " (nothing was changed in " +
+                                 out_.string() + ")");
+      }
+      moved.push_back(m);
+      done.push_back(target);
+    }
+    committed_ = true;
+    set_interrupt_output_committed();
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  return done;
+}
+
+}  // namespace asperity

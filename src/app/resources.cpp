@@ -1,0 +1,162 @@
+#include "asperity/app/resources.hpp"
+
+#include <sys/resource.h>
+#include <unistd.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "asperity/app/plan.hpp"
+#include "asperity/app/run.hpp"
+
+namespace asperity {
+
+namespace {
+
+// Measured peak RSS costs (validate-geometry --no-plots, GCC 12 Release, x86-64; /usr/bin/time
+// -f %M on runs of 1e6..4e6 asperities or drops; slope between two sizes):
+constexpr double kBaseSphere = 10.6e6;   // the process with its libraries, sphere runs
+constexpr double kBaseMesh = 19.5e6;     // mesh runs (mesh, CGAL support tree code)
+constexpr double kCentre = 24;           // one asperity centre (3 doubles)
+// Per asperity of one explicit sphere, centre included, by contact index.
+double per_asperity(Backend b) {
+  switch (b) {
+    case Backend::brute: return 24;   // a scan: the centres only
+    case Backend::kdtree: return 39;  // nanoflann
+    case Backend::cgal: return 143;
+    case Backend::fcl: return 508;
+    case Backend::grid: return 73;
+  }
+  return 508;
+}
+constexpr double kPerDropFresh = 49;      // contact samples per drop
+constexpr double kPerDropFixed = 57;      // + the rotation
+constexpr double kPerDropImpact = 92;     // + eps, Omega' (fresh or fixed)
+constexpr double kPerAsperityMesh = 108;  // a mesh body's asperity: centre, radius, support tree
+constexpr double kPerDropMesh = 68;
+constexpr double kPerImpactBounce = 64;   // one impact of a bounce sequence, kept for the analysis
+constexpr double kImpactsPerDecade = 55.5;  // fig6: 55.5 impacts from 1 m/s down to 0.1 m/s
+constexpr std::uint64_t kChunk = 4096;    // ensemble.cpp: rotations per batch
+
+int threads_of(const Scene& s) {
+  if (s.ensemble.threads > 0) return s.ensemble.threads;
+#ifdef _OPENMP
+  return std::max(1, omp_get_max_threads());
+#else
+  return 1;
+#endif
+}
+
+std::string fmt(double v) {
+  std::ostringstream os;
+  os.precision(3);
+  os << v;
+  return os.str();
+}
+
+std::string count(std::uint64_t v) { return std::to_string(v); }
+
+std::string gb(double bytes) { return fmt(bytes / 1e9) + " GB"; }
+
+}  // namespace
+
+MemoryEstimate estimate_memory(const Scene& s) {
+  const auto& e = s.ensemble;
+  const double N = double(e.sphere.asperities), n = double(e.drops);
+  MemoryEstimate m;
+  std::ostringstream d;
+  switch (run_kind(s)) {
+    case RunKind::sphere: {
+      const Plan plan = make_plan(s);
+      const auto& pe = plan.scene.ensemble;
+      double per_drop = pe.mode == Mode::fresh ? kPerDropFresh : kPerDropFixed;
+      if (pe.impact.enabled) per_drop = kPerDropImpact;
+      m.bytes = kBaseSphere + per_drop * n;
+      d << count(e.drops) << " drops x " << per_drop << " B";
+      if (pe.mode == Mode::fixed) {
+        // Few large batches: one sphere at a time; many small spheres: one per busy thread, each
+        // thread taking 4 spheres at a time (ensemble.cpp).
+        const std::uint64_t per_sphere = e.drops / std::max<std::uint64_t>(1, e.spheres);
+        const double concurrent =
+            per_sphere >= kChunk || e.spheres == 1
+                ? 1.0
+                : double(std::min<std::uint64_t>(std::uint64_t(threads_of(s)), (e.spheres + 3) / 4));
+        const double b = per_asperity(pe.backend);
+        m.bytes += concurrent * N * b;
+        d << " + " << fmt(concurrent) << " sphere(s) at once (--threads " << threads_of(s) << ") x " << count(e.sphere.asperities)
+          << " asperities x " << b << " B (" << to_string(pe.backend) << ")";
+      }
+      break;
+    }
+    case RunKind::radii: {
+      m.bytes = kBaseSphere + kPerDropFresh * n + N * per_asperity(Backend::grid);
+      d << count(e.drops) << " drops x " << kPerDropFresh << " B + one screened sphere of " << count(e.sphere.asperities) << " asperities x "
+        << per_asperity(Backend::grid) << " B";
+      break;
+    }
+    case RunKind::mesh: {
+      m.bytes = kBaseMesh + kPerDropMesh * n + kPerAsperityMesh * N;
+      d << count(e.drops) << " drops x " << kPerDropMesh << " B + one body at a time of " << count(e.sphere.asperities) << " asperities x "
+        << kPerAsperityMesh << " B";
+      break;
+    }
+    case RunKind::mesh_bounce: {
+      const double K = double(e.spheres);
+      const double impacts = kImpactsPerDecade * std::log10(s.bounce.speed / s.bounce.stop_speed);
+      const double seq = double(s.bounce.sequences);
+      m.bytes = kBaseMesh + K * N * kPerAsperityMesh + seq * impacts * kPerImpactBounce;
+      d << count(e.spheres) << " bodies kept x " << count(e.sphere.asperities) << " asperities x " << kPerAsperityMesh << " B + " << count(s.bounce.sequences)
+        << " sequences x ~" << fmt(impacts) << " impacts x " << kPerImpactBounce << " B";
+      break;
+    }
+    case RunKind::bounce: {
+      // Impacts of every sequence of a variant are kept for its analysis; a second variant adds
+      // ~a sixth (measured: one variant 42 MB, two 48 MB at 8000 sequences).
+      const double impacts = kImpactsPerDecade * std::log10(s.bounce.speed / s.bounce.stop_speed);
+      const double seq = double(s.bounce.sequences);
+      const double variants = 1.0 + (double(s.bounce.variants.size()) - 1.0) / 6.0;
+      m.bytes = kBaseSphere + seq * impacts * kPerImpactBounce * variants;
+      d << count(s.bounce.sequences) << " sequences x ~" << fmt(impacts) << " impacts x " << kPerImpactBounce << " B x " << fmt(variants)
+        << " (variants)";
+      break;
+    }
+  }
+  m.detail = d.str();
+  return m;
+}
+
+double memory_limit_bytes() {
+  const double pages = double(::sysconf(_SC_PHYS_PAGES)), page = double(::sysconf(_SC_PAGESIZE));
+  double limit = pages > 0 && page > 0 ? pages * page : 0;
+  auto lower = [&](double v) {
+    if (v > 0 && (limit == 0 || v < limit)) limit = v;
+  };
+  // cgroup v2 (containers, systemd slices): "max" or bytes.
+  if (std::ifstream f("/sys/fs/cgroup/memory.max"); f) {
+    std::string t;
+    f >> t;
+    if (!t.empty() && t != "max") lower(std::strtod(t.c_str(), nullptr));
+  }
+  struct rlimit r {};
+  if (::getrlimit(RLIMIT_AS, &r) == 0 && r.rlim_cur != RLIM_INFINITY) lower(double(r.rlim_cur));
+  return limit;
+}
+
+void check_memory(const Scene& s) {
+  const double limit = memory_limit_bytes();
+  if (!(limit > 0)) return;  // unknown: let the allocation decide
+  const MemoryEstimate m = estimate_memory(s);
+  if (m.bytes > limit)
+    throw std::invalid_argument("this run needs about " + gb(m.bytes) + " of memory (" + m.detail + "), more than the " +
+                                gb(limit) + " this process may use: lower --asperities, --drops, --spheres, --threads or "
+                                "--sequences");
+}
+
+}  // namespace asperity

@@ -1,0 +1,383 @@
+// validate-geometry against a hostile user (issue 16): a run never loses a user's files, never
+// crashes, and refuses up front what cannot run. Output: all or nothing, on failure and on any
+// signal; messages carry the system's reason.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "run_command.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using asperity::testing::run_command;
+
+std::string vg() { return VALIDATE_GEOMETRY; }
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("asperity-safety-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  return d;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Every entry of a directory (recursively) with its bytes ("<dir>" for directories).
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> m;
+  if (!fs::exists(dir)) return m;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    m[fs::relative(e.path(), dir).string()] = e.is_directory() ? "<dir>" : slurp(e.path());
+  return m;
+}
+
+// The asperity-plot-* directories of process `pid` left in the system's temporary folder.
+int plot_temporaries_of(pid_t pid) {
+  int n = 0;
+  std::string tag = "-";
+  tag += std::to_string(pid);
+  tag += '-';
+  for (const auto& e : fs::directory_iterator(fs::temp_directory_path())) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("asperity-plot-", 0) == 0 && name.find(tag) != std::string::npos) ++n;
+  }
+  return n;
+}
+
+bool has_gnuplot() { return std::system("gnuplot -e 'set terminal pngcairo' >/dev/null 2>&1") == 0; }
+
+// Starts validate-geometry with default signal dispositions (a shell's `&` would ignore SIGINT),
+// stdout and stderr into `log`.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+  std::fflush(nullptr);  // the child must not repeat our buffered output
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);
+    sigset_t none;
+    sigemptyset(&none);
+    ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    if (!std::freopen(log.c_str(), "w", stdout) || !std::freopen(log.c_str(), "a", stderr)) ::_exit(99);
+    std::vector<char*> argv;
+    std::string prog = vg();
+    argv.push_back(prog.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(98);
+  }
+  return pid;
+}
+
+int wait_status(pid_t pid) {
+  int st = 0;
+  ::waitpid(pid, &st, 0);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 1000 + WTERMSIG(st);
+}
+
+const std::vector<std::string> kRunFiles = {"r_x.png", "r_xy.png", "r_y.png", "report.json", "report.txt"};
+
+bool complete(const std::map<std::string, std::string>& snap) {
+  if (snap.size() != kRunFiles.size()) return false;
+  for (const auto& f : kRunFiles)
+    if (!snap.count(f) || snap.at(f).empty()) return false;
+  return true;
+}
+
+// Item 2: a failed rerun keeps every file of the previous run, and says why it failed.
+TEST(CliOutput, AFailedRerunKeepsThePreviousRunAndNamesTheReason) {
+  const fs::path out = fresh_dir("rerun");
+  const std::string plots = has_gnuplot() ? "" : " --no-plots";
+  auto r = run_command(vg() + " -q --asperities 1000 --drops 2000" + plots + " --out " + out.string() + " 2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  fs::remove(out / "report.txt");
+  fs::create_directory(out / "report.txt");
+  const auto before = snapshot(out);
+  r = run_command(vg() + " -q --asperities 1000 --drops 2000 --seed 9" + plots + " --out " + out.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("report.txt: Is a directory"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("Success"), std::string::npos) << r.out;
+  EXPECT_TRUE(snapshot(out) == before) << "the previous run's files changed";
+  fs::remove_all(out);
+}
+
+// Item 1: a failing run removes only what it created: files another run or the user writes into
+// the directory meanwhile stay.
+TEST(CliOutput, AFailingRunRemovesOnlyItsOwnFiles) {
+  const fs::path out = fresh_dir("others");
+  fs::create_directories(out / "report.txt");  // the run fails at the end (its table's name is taken)
+  const fs::path log = out.string() + ".log";
+  const pid_t pid = spawn({"-q", "--asperities", "1000", "--drops", "200000", "--no-plots", "--out", out.string()}, log);
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  std::ofstream(out / "notes.txt") << "the user's notes";
+  std::ofstream(out / "report.json") << "{\"another\": \"run\"}";
+  EXPECT_EQ(wait_status(pid), 2) << slurp(log);
+  EXPECT_EQ(slurp(out / "notes.txt"), "the user's notes");
+  EXPECT_EQ(slurp(out / "report.json"), "{\"another\": \"run\"}");
+  EXPECT_TRUE(fs::is_directory(out / "report.txt"));
+  EXPECT_EQ(snapshot(out).size(), 3u) << "no staging directory or temporary left";
+  fs::remove_all(out);
+  fs::remove(log);
+}
+
+// Items 3, 4: a run killed by SIGINT, SIGTERM, SIGHUP or SIGPIPE at a random point (fixed seed)
+// leaves its output directory either complete (the run had committed) or byte-for-byte as it
+// was, no temporaries in the system's temporary folder, and exits 128 + signal.
+TEST(CliOutput, SignalsAtRandomPointsLeaveTheOutputCompleteOrUnchanged) {
+  if (!has_gnuplot()) GTEST_SKIP() << "no gnuplot (the run's longest stage)";
+  const fs::path out = fresh_dir("signals");
+  const fs::path log = out.string() + ".log";
+  auto run_args = [&](int seed) {
+    return std::vector<std::string>{"-q", "--asperities", "1000", "--drops", "20000", "--seed", std::to_string(seed),
+                                    "--out", out.string()};
+  };
+  // One uninterrupted run: the previous output, and the length of a run.
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(wait_status(spawn(run_args(1), log)), 0) << slurp(log);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(complete(snapshot(out)));
+  std::mt19937 rng(16);
+  std::uniform_real_distribution<double> at(0.0, 1.3 * seconds);
+  int interrupted = 0, completed = 0, seed = 2;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
+    for (int k = 0; k < 6; ++k) {
+      const auto before = snapshot(out);
+      const double t = at(rng);
+      const pid_t pid = spawn(run_args(seed++), log);
+      std::this_thread::sleep_for(std::chrono::duration<double>(t));
+      ::kill(pid, sig);
+      const int status = wait_status(pid);
+      const auto after = snapshot(out);
+      const std::string what = std::string(strsignal(sig)) + " after " + std::to_string(t) + " s: " + slurp(log);
+      if (status == 1000 + sig && after == before) {
+        // Killed before main() installed the handlers (process start-up, a loaded machine): the
+        // default action, which a shell also reports as 128 + signal; nothing was touched.
+        ++interrupted;
+      } else if (status == 128 + sig && after == before) {
+        ++interrupted;
+        EXPECT_NE(slurp(log).find("interrupted by"), std::string::npos) << what;
+      } else {
+        // The signal came after the commit (or the run ended first): the new run is complete.
+        EXPECT_TRUE(status == 0 || status == 1 || status == 128 + sig) << status << " " << what;
+        EXPECT_TRUE(complete(after)) << what;
+        EXPECT_NE(after.at("report.json"), before.at("report.json")) << what;
+        ++completed;
+      }
+      EXPECT_EQ(plot_temporaries_of(pid), 0) << what;
+    }
+  }
+  EXPECT_GT(interrupted, 4) << "the random points must hit running runs";
+  std::cout << interrupted << " interrupted, " << completed << " completed\n";
+  fs::remove_all(out);
+  fs::remove(log);
+}
+
+// Item 4: gnuplot failing on the second figure leaves the previous first figure in place.
+TEST(CliOutput, AGnuplotFailureOnTheSecondFigureKeepsThePreviousRun) {
+  if (!has_gnuplot()) GTEST_SKIP() << "no gnuplot";
+  const fs::path out = fresh_dir("gnuplot2");
+  auto r = run_command(vg() + " -q --asperities 1000 --drops 2000 --out " + out.string() + " 2>&1");
+  ASSERT_EQ(r.status, 0) << r.out;
+  const auto before = snapshot(out);
+  // A gnuplot that works for the availability check and the first figure, then fails.
+  const fs::path bin = fresh_dir("fake-gnuplot");
+  fs::create_directories(bin);
+  const std::string real = run_command("command -v gnuplot").out;
+  std::ofstream(bin / "gnuplot") << "#!/bin/sh\nn=$(cat " << (bin / "count").string() << " 2>/dev/null || echo 0)\n"
+                                 << "echo $((n + 1)) > " << (bin / "count").string() << "\n"
+                                 << "[ \"$n\" -ge 2 ] && { echo 'fake gnuplot: failing' >&2; exit 1; }\n"
+                                 << "exec " << real.substr(0, real.find('\n')) << " \"$@\"\n";
+  fs::permissions(bin / "gnuplot", fs::perms::owner_all);
+  r = run_command("PATH=" + bin.string() + ":$PATH " + vg() + " -q --asperities 1000 --drops 2000 --seed 4 --out " +
+                  out.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("fake gnuplot: failing"), std::string::npos) << r.out;
+  EXPECT_EQ(slurp(bin / "count"), "3\n");
+  EXPECT_TRUE(snapshot(out) == before) << "the previous figures changed";
+  fs::remove_all(out);
+  fs::remove_all(bin);
+}
+
+// Item 13: a full disk says so (a tmpfs of 8 or 100 kB in a private mount namespace).
+TEST(CliOutput, AFullDiskSaysNoSpaceLeft) {
+  if (run_command("unshare -rm true 2>/dev/null").status != 0) GTEST_SKIP() << "unshare -rm not permitted here";
+  const fs::path mnt = fresh_dir("full");
+  fs::create_directories(mnt);
+  struct Case {
+    std::string size, args, says;
+  };
+  std::vector<Case> cases = {{"8k", "--no-plots", "report.json: No space left on device"}};
+  if (has_gnuplot()) cases.push_back({"100k", "", "no space left on device"});
+  for (const auto& c : cases) {
+    const auto r = run_command("unshare -rm sh -c 'mount -t tmpfs -o size=" + c.size + " tmpfs " + mnt.string() + " && " +
+                               vg() + " -q --asperities 1000 --drops 2000 " + c.args + " --out " + mnt.string() +
+                               "/out; echo status=$?; ls -A " + mnt.string() + "' 2>&1");
+    EXPECT_NE(r.out.find("status=2"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(c.says), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("out\n"), std::string::npos) << "the directory the run created is removed:\n" << r.out;
+    EXPECT_EQ(r.out.find("gnuplot produced no output"), std::string::npos) << r.out;
+  }
+  fs::remove_all(mnt);
+}
+
+}  // namespace
+
+namespace {
+
+struct Refusal {
+  std::string args;       // command-line arguments (a scene file's text replaces @SCENE@)
+  std::string scene;      // the scene file, if any
+  std::string must_say;
+};
+
+std::string mesh_scene(const std::string& body_extra, const std::string& extra = "") {
+  return "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"" + std::string(SCENES_DIR) + "/../meshes/ellipsoid.off\"\n" +
+         body_extra + "[asperities]\ncount = 500\n" + extra +
+         "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 100\n"
+         "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n[outputs]\nplots = false\n";
+}
+
+std::string mesh_bounce_scene() {
+  return "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"" + std::string(SCENES_DIR) + "/../meshes/ellipsoid.off\"\n"
+         "[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\nspheres = 2\n"
+         "[experiment]\nkind = \"bounce\"\nspeed = 0.5\nstop_speed = 0.2\nsequences = 2\n[outputs]\nplots = false\n";
+}
+
+// Items 5-10, 12, 13: what cannot run, or would run to nonsense, is refused before the output
+// directory is touched (exit 2), naming the key or option and the value.
+TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
+  const std::vector<Refusal> cases = {
+      // 5: a mesh's smooth surface, scale, exponent (exit 134 or nonsense before)
+      {"", mesh_scene("smooth = [1e300, 1e300, 1e300]\n"), "body.smooth: semi-axis 0 must be in [1e-15, 1e+06] m (supported range), got 1e+300"},
+      {"", mesh_scene("smooth = [1e150, 1e150, 1e150]\n"), "body.smooth"},
+      {"", mesh_scene("smooth = [1e-9, 1e-9, 1e-9]\n"), "body.smooth"},
+      {"", mesh_scene("smooth = [4e-3, 3e-3, 2.25e-3, 2000]\n"), "body.smooth: exponent m must be in [2, 100], got 2000"},
+      {"", mesh_scene("scale = 1e6\n"), "body.scale = 1e+06"},
+      {"", mesh_scene("scale = 1e9\n"), "body.scale"},
+      {"", mesh_scene("scale = 1e-9\n"), "asperities.radius"},
+      // 6: one spin rule for every body
+      {"--omega-x 1e300", mesh_bounce_scene(), "experiment.Omega (--omega-x/--omega-y)"},
+      {"--omega-y 1e12", mesh_bounce_scene(), "surface speed of 4e+09 m/s"},
+      {"--omega-y 1e12 --speed 1", "", "spin"},
+      // 7: radii below the supported range
+      {"", "format = 1\n[asperities]\ncount = 2000\nradius = { distribution = \"lognormal\", median = 1e-300, sigma = 0.3 }\n",
+       "asperities.radius.median: must be in [1e-15, 1e+06] m"},
+      {"", "format = 1\n[asperities]\ncount = 2000\nradius = { distribution = \"levels\", radii = [1e-300, 6.5e-7], "
+           "fractions = [0.5, 0.5] }\n",
+       "asperities.radius.radii"},
+      // 8: output names
+      {"", "format = 1\n[outputs]\nreport = \"r_xy.png\"\n", "outputs.report"},
+      {"", mesh_scene("", "") + "export_ply = \"report.json\"\n", "outputs.export_ply"},
+      {"", mesh_scene("", "") + "export_ply = \"report.txt\"\n", "outputs.export_ply"},
+      {"", "format = 1\n[outputs]\nreport = \"a\\u0000b.json\"\n", "control character"},
+      {"", "format = 1\n[outputs]\nreport = \"sub/r.json\"\n", "outputs.report"},
+      // 9: duplicate variants
+      {"--preset fig6 --variant paper,paper", "", "--variant: 'paper' is given twice"},
+      {"", "format = 1\n[experiment]\nkind = \"bounce\"\nvariants = \"dynamic,paper,dynamic\"\n", "experiment.variants"},
+      // 10: integers as integers
+      {"--seed \" -5\"", "", "--seed: ' -5'"},
+      {"--asperities 0x10", "", "--asperities: '0x10'"},
+      {"--asperities +16", "", "--asperities: '+16'"},
+      {"--asperities \" 16\"", "", "--asperities: ' 16'"},
+      {"--asperities 9007199254740993", "", "'9007199254740993' must be <= 4294967295"},
+      {"--out= --no-plots", "", "--out: ''"},
+      // 12: one rotation per body; radius levels capped
+      {"--drops 2 --spheres 2", mesh_scene(""), "ensemble.drops (--drops)"},
+      {"", "format = 1\n[asperities]\ncount = 2000\nradius = { distribution = \"levels\", radii = [" +
+               [] {
+                 std::string r;
+                 for (int i = 0; i < 17; ++i) r += (i ? ", " : "") + std::to_string(6.5e-7 * (1 + i / 17.0));
+                 return r;
+               }() +
+               "], fractions = [" +
+               [] {
+                 std::string f;
+                 for (int i = 0; i < 17; ++i) f += (i ? ", " : "") + std::string(i < 16 ? "0.0625" : "0.0");
+                 return f;
+               }() +
+               "] }\n",
+       "at most 16 levels"},
+      // 13: numbers out of range are numbers; ranges name the option or key
+      {"--alpha 4.9e-324", "", "--alpha: '4.9e-324' is out of range"},
+      {"--asperities 1e-400", "", "--asperities: '1e-400' must be a whole number"},
+      {"--asperities 5000000000", "", "--asperities: '5000000000' must be <= 4294967295"},
+      {"", "format = 1\n[ensemble]\nthreads = 2000\n", ":3: ensemble.threads: must be <= 1024"},
+      {"--foo 1 --bar 2", "", "not expected: --foo 1 --bar 2"},
+  };
+  for (const auto& c : cases) {
+    const fs::path out = fresh_dir("refused");
+    std::string args = c.args;
+    fs::path scene;
+    if (!c.scene.empty()) {
+      scene = out.string() + ".toml";
+      std::ofstream(scene) << c.scene;
+      args = "--scene " + scene.string() + " " + args;
+    }
+    const auto r = run_command(vg() + " -q " + args + " --out " + out.string() + " 2>&1");
+    EXPECT_EQ(r.status, 2) << args << "\n" << c.scene << r.out;
+    EXPECT_NE(r.out.find(c.must_say), std::string::npos) << args << "\n" << c.scene << "did not say: " << c.must_say
+                                                         << "\n" << r.out;
+    EXPECT_FALSE(fs::exists(out)) << args << ": the output directory was touched";
+    if (!scene.empty()) fs::remove(scene);
+    fs::remove_all(out);
+    fs::remove_all("--no-plots");  // the old parser made it the output directory
+  }
+}
+
+// Item 13: a mesh body's asperity radius is checked against the body, not the unused sphere
+// radius: 0.01 m runs on the ellipsoid scaled x10 (semi-axes 40, 30, 22.5 mm).
+TEST(CliRefusals, MeshAsperityRadiusIsCheckedAgainstTheBody) {
+  const fs::path out = fresh_dir("mesh-radius");
+  const fs::path scene = out.string() + ".toml";
+  std::ofstream(scene) << mesh_scene("scale = 10\n", "radius = { distribution = \"fixed\", value = 0.01 }\n");
+  auto r = run_command(vg() + " -q --scene " + scene.string() + " --omega-x 0.01 --out " + out.string() + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_TRUE(fs::exists(out / "report.json"));
+  fs::remove_all(out);
+  std::ofstream(scene) << mesh_scene("", "radius = { distribution = \"fixed\", value = 0.01 }\n");
+  r = run_command(vg() + " -q --scene " + scene.string() + " --out " + out.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("smallest half-extent 0.00225 m"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("radius (0.003 m)"), std::string::npos) << r.out;
+  fs::remove(scene);
+  fs::remove_all(out);
+}
+
+}  // namespace
+
+namespace {
+
+// Item 3: `validate-geometry ... | true` (the reader goes away): the table is printed after the
+// files are in place, so the run is complete and exits 141 (128 + SIGPIPE) saying so.
+TEST(CliOutput, AClosedPipeAfterTheRunKeepsItsCompleteOutput) {
+  const fs::path out = fresh_dir("pipe");
+  const std::string plots = has_gnuplot() ? "" : " --no-plots";
+  const auto r = run_command("bash -c '" + vg() + " --asperities 1000 --drops 2000" + plots + " --out " + out.string() +
+                             " 2>" + out.string() + ".err | true; echo status=${PIPESTATUS[0]}'");
+  EXPECT_NE(r.out.find("status=141"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(out / "report.json") && fs::exists(out / "report.txt")) << r.out;
+  if (plots.empty()) {
+    EXPECT_TRUE(complete(snapshot(out)));
+  }
+  EXPECT_NE(slurp(out.string() + ".err").find("the run had completed; its files are in place"), std::string::npos);
+  fs::remove_all(out);
+  fs::remove(out.string() + ".err");
+}
+
+}  // namespace
