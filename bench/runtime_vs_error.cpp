@@ -249,17 +249,17 @@ int main(int argc, char** argv) {
          }
          return x;
        }},
-      {"fresh-cap", 1, [&](std::uint64_t n) { return ensemble(Mode::fresh, Backend::grid, n, 1); }},
-      {"fresh-full", 1, [&](std::uint64_t n) { return ensemble(Mode::fixed, Backend::brute, n, n); }},
+      {"fresh-cap", 1, [&](std::uint64_t n) { return ensemble(Mode::sampled, Backend::grid, n, 1); }},
+      {"fresh-full", 1, [&](std::uint64_t n) { return ensemble(Mode::explicit_spheres, Backend::brute, n, n); }},
   };
   // Every backend answers the same query exactly, so their error curves coincide for a given
   // sphere: what differs is the time axis.
   for (const Backend b : all_backends()) {
     const std::string name(to_string(b));
     strategies.push_back({"fixed-" + name + "-1sphere", 1,
-                          [&, b](std::uint64_t n) { return ensemble(Mode::fixed, b, n, 1); }});
+                          [&, b](std::uint64_t n) { return ensemble(Mode::explicit_spheres, b, n, 1); }});
     strategies.push_back({"fixed-" + name + "-Kspheres", K,
-                          [&, b](std::uint64_t n) { return ensemble(Mode::fixed, b, n, K); }});
+                          [&, b](std::uint64_t n) { return ensemble(Mode::explicit_spheres, b, n, K); }});
   }
 
   if (!o.only.empty()) {

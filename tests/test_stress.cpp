@@ -269,7 +269,7 @@ TEST(Stress, ReportsBitIdenticalForThreadCountsAndRepeats) {
     j["parameters"].erase("threads");
     return j.dump();
   };
-  for (Mode m : {Mode::fresh, Mode::fixed}) {
+  for (Mode m : {Mode::sampled, Mode::explicit_spheres}) {
     const std::string one = report(m, 1), two = report(m, 2), again = report(m, 2);
     EXPECT_EQ(one, two) << to_string(m);
     EXPECT_EQ(two, again) << to_string(m);

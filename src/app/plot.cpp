@@ -213,7 +213,7 @@ std::string build_script(const HistogramFigure& fig, const fs::path& out) {
 
   // Legend entry for the data first, then the curves, then the data drawn on top without a title.
   const std::string data_title =
-      "explicit geometry (n = " + format_count(h.total) + ")";
+      fig.data_label + " (n = " + format_count(h.total) + ")";
   auto plot_cmd = [&](bool log_panel) {
     s << "plot NaN with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 title "
       << gp_text(data_title);

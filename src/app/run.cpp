@@ -282,6 +282,7 @@ GeometryReport run_scene(const Scene& s, const Progress& progress) {
   plan.stage("generate").seconds = samples.seconds_generate;
   plan.stage("index").seconds = samples.seconds_index;
   plan.stage("query").seconds = samples.seconds_query;
+  if (plan.runs("cross_check")) plan.stage("cross_check").seconds = samples.cross_check.seconds;
   plan.stage("impact").seconds = samples.seconds_impact;
   r.plan = std::move(plan.stages);
   r.scene_toml = to_toml(s);

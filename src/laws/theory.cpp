@@ -132,6 +132,17 @@ Law exact_sphere_rx(std::uint64_t n, double R) {
   return law;
 }
 
+double model_error_scale(std::uint64_t n, double R) {
+  const Law a = eq14_rxy(n, R), b = exact_sphere_rxy(n, R);
+  const double hi = std::min(R, 12.0 / std::sqrt(2.0 * pi * areal_density(n, R)));
+  double d = 0;
+  for (int i = 1; i <= 4000; ++i) {
+    const double t = hi * i / 4000.0;
+    d = std::max(d, std::abs(a.cdf(t) - b.cdf(t)));
+  }
+  return d;
+}
+
 double core_contact_probability(std::uint64_t n, double R, double a) {
   return std::exp(static_cast<double>(n) * std::log1p(-a / (2.0 * R)));
 }

@@ -23,9 +23,9 @@ Scene reference_preset(const std::string& name) {
   s.ensemble.seed = 1;
   s.name = name;
   if (name == "fig3") {
-    s.ensemble.mode = Mode::fresh;
+    s.ensemble.mode = Mode::sampled;
   } else if (name == "fig3-fixed") {
-    s.ensemble.mode = Mode::fixed;
+    s.ensemble.mode = Mode::explicit_spheres;
     s.ensemble.spheres = 100;
     s.ensemble.backend = Backend::grid;
     s.backend_auto = false;  // the file names its backend
@@ -345,7 +345,7 @@ TEST(SceneFileBodies, ExampleScenesParseIntoTheExpectedFields) {
   EXPECT_EQ(lv.radii->screen_directions, 100000u);
   EXPECT_EQ(lv.ensemble.sphere.asperities, 100000u);
   EXPECT_EQ(lv.ensemble.sphere.radius, 3e-3);
-  EXPECT_EQ(lv.ensemble.mode, Mode::fresh);
+  EXPECT_EQ(lv.ensemble.mode, Mode::sampled);
   EXPECT_EQ(lv.ensemble.drops, 100000u);
   EXPECT_FALSE(lv.ensemble.impact.enabled);
 
@@ -362,7 +362,7 @@ TEST(SceneFileBodies, ExampleScenesParseIntoTheExpectedFields) {
   EXPECT_FALSE(parse_scene(kMesh).mesh->export_points);
   EXPECT_EQ(el.ensemble.sphere.asperities, 100000u);
   EXPECT_EQ(el.ensemble.sphere.asperity_radius, 6.5e-7);
-  EXPECT_EQ(el.ensemble.mode, Mode::fixed);
+  EXPECT_EQ(el.ensemble.mode, Mode::explicit_spheres);
   EXPECT_EQ(el.ensemble.spheres, 10u);
   EXPECT_EQ(el.ensemble.drops, 100000u);
   EXPECT_TRUE(el.ensemble.impact.enabled);

@@ -31,7 +31,7 @@ const TestReport& find(const GeometryReport& r, const std::string& q, const std:
 std::vector<double> full_generation_rxy(std::uint64_t n, std::uint64_t drops, std::uint64_t seed) {
   EnsembleConfig c;
   c.sphere = {n, 3e-3, 6.5e-7};
-  c.mode = Mode::fixed;
+  c.mode = Mode::explicit_spheres;
   c.spheres = drops;  // one rotation per sphere: every drop is a new explicit sphere
   c.drops = drops;
   c.seed = seed;
@@ -46,14 +46,14 @@ TEST(Fresh, SameLawAsGeneratingAllNAsperities) {
   // (a 6% change in the Rayleigh scale, D ~ 0.04).
   EnsembleConfig c;
   c.sphere = {50, 3e-3, 6.5e-7};
-  c.mode = Mode::fresh;
+  c.mode = Mode::sampled;
   c.drops = 20000;
   c.seed = 3;
   const auto fresh = run_contact_ensemble(c);
   const auto full = sorted(full_generation_rxy(50, 20000, 4));
   EXPECT_GT(ks_two_sample(sorted(fresh.r_xy), full).p, 1e-3);
   EXPECT_GT(ks_two_sample(sorted(fresh.gap), sorted([&] {
-                            c.mode = Mode::fixed, c.spheres = 20000, c.backend = Backend::brute, c.seed = 4;
+                            c.mode = Mode::explicit_spheres, c.spheres = 20000, c.backend = Backend::brute, c.seed = 4;
                             return run_contact_ensemble(c).gap;
                           }())).p,
             1e-3);
@@ -70,7 +70,7 @@ TEST(Fresh, CapSamplerIsTheExactOrderStatistic) {
 }
 
 TEST(Ensembles, BitIdenticalForOneAndTwoThreads) {
-  for (Mode m : {Mode::fresh, Mode::fixed}) {
+  for (Mode m : {Mode::sampled, Mode::explicit_spheres}) {
     EnsembleConfig c;
     c.sphere = {5000, 3e-3, 6.5e-7};
     c.mode = m;
@@ -117,7 +117,7 @@ TEST(Fixed, ManyRotationsOfOneSmallSphereAreReportedAsQuenched) {
   // decisive one-per-sphere test must not reject.
   Scene s = preset("fig3");
   s.ensemble.sphere.asperities = 200;
-  s.ensemble.mode = Mode::fixed;
+  s.ensemble.mode = Mode::explicit_spheres;
   s.ensemble.spheres = 1;
   s.ensemble.drops = 200000;
   s.ensemble.backend = Backend::grid;
@@ -138,7 +138,7 @@ TEST(Fixed, ManySpheresAgreeWithTheLaws) {
   // 400 spheres of N = 2000 x 50 rotations: se from batch means, decisive tests on 400 iid drops.
   Scene s = preset("fig3");
   s.ensemble.sphere.asperities = 2000;
-  s.ensemble.mode = Mode::fixed;
+  s.ensemble.mode = Mode::explicit_spheres;
   s.ensemble.spheres = 400;
   s.ensemble.drops = 20000;
   s.ensemble.backend = Backend::kdtree;

@@ -47,6 +47,11 @@ struct Scene {
   /// ensemble.backend was not chosen by the user: the planner picks a scan or an index from the
   /// work per sphere (fixed mode). Results do not depend on the choice (every backend is exact).
   bool backend_auto = true;
+  /// ensemble.spheres was not chosen (explicit design): the planner takes K from the error budget
+  /// (auto_spheres, ensemble.hpp). Scene files write it as spheres = "auto".
+  bool spheres_auto = true;
+  /// Set when the scene named a mode by an earlier name ("fresh", "fixed"): what it runs as.
+  std::string mode_note;
   double alpha = 0.01;        ///< significance level of each test
   bool plots = true;          ///< write PNG figures (needs gnuplot)
   bool contact_stats = true;  ///< analyse r_xy, r_x, r_y, r_z and core contacts against their laws

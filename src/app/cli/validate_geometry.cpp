@@ -51,7 +51,7 @@ void check_memory(const EnsembleConfig& e) {
   if (!(pages > 0 && page > 0)) return;  // unknown: let the allocation decide
   const double ram = pages * page;
   double need = 64.0 * double(e.drops);
-  if (e.mode == Mode::fixed) need += 2.0 * 24.0 * double(e.sphere.asperities);  // centres + index, at least
+  if (e.mode == Mode::explicit_spheres) need += 2.0 * 24.0 * double(e.sphere.asperities);  // centres + index, at least
   if (need > ram) {
     std::ostringstream os;
     os << "--asperities " << e.sphere.asperities << " with --drops " << e.drops << " (" << to_string(e.mode)
