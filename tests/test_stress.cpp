@@ -253,8 +253,9 @@ TEST(Stress, EnsemblesAtTheEdgesOfTheSupportedRanges) {
   }
 }
 
-// Bit-identical results for 1 and 2 threads and for repeated runs, fresh and fixed, with impacts;
-// the report is compared as JSON text with the wall-clock timings removed.
+// Bit-identical results for 1 and 2 threads and for repeated runs, sampled and explicit (40 spheres:
+// the decisive sphere-block bootstrap runs), with impacts; the report is compared as JSON text
+// with the wall-clock timings removed.
 TEST(Stress, ReportsBitIdenticalForThreadCountsAndRepeats) {
   auto report = [](Mode mode, int threads) {
     Scene scene = preset("fig4");
@@ -262,7 +263,7 @@ TEST(Stress, ReportsBitIdenticalForThreadCountsAndRepeats) {
     e.mode = mode;
     e.sphere.asperities = 2000;
     e.drops = 4000;
-    e.spheres = 4;
+    e.spheres = 40;
     e.threads = threads;
     auto j = nlohmann::json::parse(to_json(analyse(scene, run_contact_ensemble(e))));
     j.erase("timings_s");

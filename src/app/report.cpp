@@ -611,8 +611,13 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
   std::ostringstream sub;
   const bool expl = scene.ensemble.mode == Mode::explicit_spheres;
   const std::uint64_t K = expl ? scene.ensemble.spheres : s.r_xy.size();
-  sub << "N = " << sp.asperities << ", {/Symbol r} = " << sp.asperity_radius << " m, n = " << s.r_xy.size() << "\\n"
-      << design_label(expl ? "explicit" : "sampled", K, s.r_xy.size() / K, std::string(to_string(scene.ensemble.backend)));
+  sub << "N = " << sp.asperities << ", {/Symbol r} = " << sp.asperity_radius << " m";
+  // The legend of the measured points names the ensemble they come from.
+  const std::string data_label =
+      expl ? "explicit geometry: " + std::to_string(K) + (K == 1 ? " sphere x " : " spheres x ") +
+                 std::to_string(s.r_xy.size() / K) + " rotations, " + std::string(to_string(scene.ensemble.backend)) +
+                 " query"
+           : std::string("sampled from the exact finite-N law, no geometry");
   std::string law_note;  // the report says why a law is missing
   for (const auto& set : laws_for(scene.ensemble, scene.contact_stats,
                                   s.no_impacts == 0 && s.eps.size() == s.r_xy.size(), law_note)) {
@@ -644,7 +649,7 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
       fig.ylabel = eps ? "probability density" : "probability density [s/rad]";
     }
     fig.histogram = make_histogram(x, lo, hi, 60);
-    fig.data_label = expl ? "explicit geometry" : "sampled, no geometry";
+    fig.data_label = data_label;
     for (const auto& law : set.laws) {
       const std::string label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
                                 : law.name == "eq18" ? "Eq. (18), Gaussian"
