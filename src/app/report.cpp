@@ -255,7 +255,7 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
     note << "sampled from the exact finite-N law of the lowest asperity -- no geometry: the two lowest asperities of "
             "each drop are drawn from the order statistics of the polar angle; no sphere is built. Drops are iid.";
   }
-  if (!scene.mode_note.empty()) note << " " << scene.mode_note;
+  if (!scene.legacy_mode.empty()) note << " " << legacy_mode_note(scene.legacy_mode);
   r.ensemble_note = note.str();
 
   std::vector<std::string> names;

@@ -357,7 +357,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     if (auto m = ens->choice("mode", {"explicit", "sampled", "fresh", "fixed"})) {
       e.mode = parse_mode(*m);
       if (*m == "fresh" && s.radii && !s.mesh) e.mode = Mode::sampled;
-      else if (is_legacy_mode(*m)) s.mode_note = legacy_mode_note(*m);
+      else if (is_legacy_mode(*m)) s.legacy_mode = *m;
     } else if (s.radii && !s.mesh) {
       e.mode = Mode::sampled;  // unequal radii on a sphere: the exact sampler is their only design
     }
@@ -490,7 +490,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     ex->finish();
   }
   impact.enabled = impacts;
-  if (s.bounce.enabled || s.mesh) s.spheres_auto = false, s.mode_note.clear();  // their own designs
+  if (s.bounce.enabled || s.mesh) s.spheres_auto = false, s.legacy_mode.clear();  // their own designs
   if (s.mesh && !impacts && !s.bounce.enabled)
     top.fail(nullptr, "experiment.kind",
              "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega) or \"bounce\"");
@@ -723,7 +723,9 @@ std::string to_toml(const Scene& s) {
   }
   if (s.radii)
     os << "[screening]\nbodies = " << s.radii->screen_bodies << "\ndirections = " << s.radii->screen_directions << "\n\n";
-  os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\n";
+  // A scene that named a mode by its earlier name is written as it was named (it runs as explicit).
+  os << "[ensemble]\nmode = \"" << (s.legacy_mode.empty() ? to_string(e.mode) : std::string_view(s.legacy_mode))
+     << "\"\ndrops = " << e.drops << "\n";
   if (e.mode == Mode::explicit_spheres) {  // sampled drops have no explicit spheres
     if (s.spheres_auto)
       os << "spheres = \"auto\"\n";

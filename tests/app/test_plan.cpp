@@ -19,7 +19,7 @@ Scene small(const std::string& name) {
   Scene s = preset(name);
   s.ensemble.sphere.asperities = 2000;
   s.ensemble.drops = 4000;
-  if (s.ensemble.mode == Mode::explicit_spheres) s.ensemble.spheres = 4;
+  if (s.ensemble.mode == Mode::explicit_spheres && !s.spheres_auto) s.ensemble.spheres = 4;
   s.plots = false;
   return s;
 }

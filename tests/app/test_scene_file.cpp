@@ -245,7 +245,7 @@ TEST(SceneFile, NanInfAndOutOfRangeValuesAreErrorsNamingKeyAndValue) {
   // The earlier names still read: fixed and fresh run as explicit, and say so.
   const Scene legacy = parse_scene(replace(kGood, "mode = \"fixed\"", "mode = \"fresh\""));
   EXPECT_EQ(legacy.ensemble.mode, Mode::explicit_spheres);
-  EXPECT_NE(legacy.mode_note.find("fresh"), std::string::npos);
+  EXPECT_EQ(legacy.legacy_mode, "fresh");
   EXPECT_EQ(parse_scene(kGood).ensemble.mode, Mode::explicit_spheres);
   EXPECT_TRUE(parse_scene(replace(kGood, "spheres = 10", "spheres = \"auto\"")).spheres_auto);
   expect_error(replace(kGood, "spheres = 10", "spheres = \"many\""), "ensemble.spheres", "many");

@@ -126,7 +126,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     if (given("--mode")) {
       e.mode = parse_mode(mode);
       // Earlier names: "fixed" = explicit; "fresh" = explicit (with a note), for unequal radii their sampler.
-      scene.mode_note = is_legacy_mode(mode) && !radii ? legacy_mode_note(mode) : std::string();
+      scene.legacy_mode = is_legacy_mode(mode) && !radii && !mesh && !bounce ? mode : std::string();
       if (radii && mode == "fresh") e.mode = Mode::sampled;
       // A backend the file chose for its explicit spheres does not apply to sampled drops.
       if (e.mode == Mode::sampled && !given("--backend")) scene.backend_auto = true;
