@@ -478,11 +478,17 @@ std::vector<double> q7_select(std::vector<double>& v, std::span<const double> pr
   }
   std::sort(ranks.begin(), ranks.end());
   ranks.erase(std::unique(ranks.begin(), ranks.end()), ranks.end());
-  std::size_t lo = 0;
-  for (std::size_t r : ranks) {
-    std::nth_element(v.begin() + static_cast<std::ptrdiff_t>(lo), v.begin() + static_cast<std::ptrdiff_t>(r), v.end());
-    lo = r + 1;
-  }
+  // Multi-select: place the middle rank, then recurse into each side with the ranks that lie there
+  // (O(n log k) for k ranks, against O(n k) for one nth_element after another).
+  auto select = [&](auto&& self, std::size_t lo, std::size_t hi, std::size_t r0, std::size_t r1) -> void {
+    if (r0 >= r1 || lo >= hi) return;
+    const std::size_t mid = (r0 + r1) / 2, r = ranks[mid];
+    std::nth_element(v.begin() + static_cast<std::ptrdiff_t>(lo), v.begin() + static_cast<std::ptrdiff_t>(r),
+                     v.begin() + static_cast<std::ptrdiff_t>(hi));
+    self(self, lo, r, r0, mid);
+    self(self, r + 1, hi, mid + 1, r1);
+  };
+  select(select, 0, n, 0, ranks.size());
   // v now holds every needed rank at its sorted position.
   std::vector<double> out;
   for (double p : probs) out.push_back(q7(v, p));
