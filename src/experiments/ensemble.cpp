@@ -268,10 +268,13 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& pro
     const double budget = std::max(100.0, std::floor(kCrossCheckScanBudget / double(n)));
     const auto total_checks = static_cast<std::uint64_t>(
         std::min({double(c.drops), 1e4, std::max(100.0, std::min(0.01 * double(c.drops), budget))}));
-    const std::uint64_t check_spheres = K == 1 ? 1 : 2;
-    const std::uint64_t per_sphere = std::max<std::uint64_t>(1, total_checks / check_spheres);
+    // Spheres 0, s, 2s, ...: two of them, or as many as the quota needs when spheres have few rotations.
+    const std::uint64_t check_spheres =
+        std::min<std::uint64_t>(K, std::max<std::uint64_t>(K == 1 ? 1 : 2, (total_checks + m - 1) / m));
+    const std::uint64_t sphere_stride = K / check_spheres;
+    const std::uint64_t per_sphere = std::max<std::uint64_t>(1, (total_checks + check_spheres - 1) / check_spheres);
     const std::uint64_t stride = std::max<std::uint64_t>(1, m / per_sphere);
-    auto is_checked = [&](std::uint64_t k) { return k == 0 || k == K - 1; };
+    auto is_checked = [&](std::uint64_t k) { return k % sphere_stride == 0 && k / sphere_stride < check_spheres; };
 
     // Rotations [b, e) of sphere k, drops [k m + b, k m + e): the same streams whichever loop runs them.
     auto rotate = [&](const RoughSphere& body, const ContactQuery& index, std::uint64_t k, std::uint64_t b,
@@ -291,8 +294,8 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& pro
         if (checks && j % stride == 0 && checks->size() < per_sphere) checks->emplace_back(d[j - b], r);
       }
     };
-    std::vector<SphereCheck> checks(K == 1 ? 1 : 2);
-    auto check_slot = [&](std::uint64_t k) -> SphereCheck& { return checks[k == 0 ? 0 : 1]; };
+    std::vector<SphereCheck> checks(check_spheres);
+    auto check_slot = [&](std::uint64_t k) -> SphereCheck& { return checks[k / sphere_stride]; };
     double seconds_check = 0;
     if (K == 1) {
       // One sphere: its rotations in parallel.
