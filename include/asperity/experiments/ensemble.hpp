@@ -99,8 +99,8 @@ struct EnsembleConfig {
 void validate(const EnsembleConfig& c);
 
 /// A deterministic subsample of an explicit run's queries answered again by other exact backends:
-/// drops j (a multiple of a stride) of spheres 0, s, 2s, ... (two spheres, more when they have too
-/// few rotations for the quota; s = K / their number), about 1 % of the drops, at least
+/// drops j (a multiple of a stride) of spheres 0, s, 2s, ... (as few as hold the quota: one when it
+/// has enough rotations; s = K / their number), about 1 % of the drops, at least
 /// 100 and at most 10^4, and fewer when the brute scans would cost more than ~5 % of the run
 /// (queries x N <= kCrossCheckScanBudget; never fewer than 100). Backends: brute and kdtree (each
 /// skipped when it is the run's own backend), fcl when built and N <= kCrossCheckFclMax (its
