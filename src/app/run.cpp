@@ -251,7 +251,8 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress) {
   o.files = r.plots;
   o.rejected = r.rejected();
   for (const auto& t : r.tests)
-    if (t.decisive && t.verdict == "skipped") o.skipped.push_back(t.quantity + " " + t.law + " (" + t.scope + "): " + t.note);
+    if (t.decisive && (t.verdict == "skipped" || t.verdict == "undecided"))
+      o.skipped.push_back(t.quantity + " " + t.law + " (" + t.verdict + "): " + t.note);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = r.scene.name;
