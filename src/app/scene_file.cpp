@@ -218,7 +218,6 @@ class Reader {
   std::set<std::string> used_;
 };
 
-constexpr std::uint64_t kMaxAsperities = (std::uint64_t{1} << 32) - 1;  // geometry.hpp: N < 2^32
 constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
 
 // THE mapping from a scene file to a Scene: every section and key of format 1 is read here, and

@@ -13,10 +13,13 @@ namespace asperity {
 
 using detail::num;
 
+void check_asperity_count(std::uint64_t n, std::string_view what) {
+  if (n < 1 || n > kMaxAsperities)
+    throw std::invalid_argument(std::string(what) + " must be in [1, 2^32-1], got " + std::to_string(n));
+}
+
 void validate(const SphereParams& p) {
-  if (p.asperities < 1) throw std::invalid_argument("asperities must be >= 1, got 0");
-  if (p.asperities > (std::uint64_t{1} << 32) - 1)
-    throw std::invalid_argument("asperities must be < 2^32, got " + std::to_string(p.asperities));
+  check_asperity_count(p.asperities);
   if (!std::isfinite(p.radius) || p.radius <= 0)
     throw std::invalid_argument("radius must be a finite number > 0 m, got " + num(p.radius));
   if (!std::isfinite(p.asperity_radius) || p.asperity_radius <= 0)

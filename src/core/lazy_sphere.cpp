@@ -50,8 +50,7 @@ std::uint64_t binomial_half(std::uint64_t n, Stream& s) {
 
 LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size)
     : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)) {
-  if (n < 1 || n > 0xFFFFFFFFull)
-    throw std::invalid_argument("lazy sphere: asperities must be in [1, 2^32 - 1], got " + std::to_string(n));
+  check_asperity_count(n, "lazy sphere: asperities");
   reset(seed, sphere_id);
 }
 

@@ -82,7 +82,7 @@ SurfaceMap smooth_surface(const std::vector<double>& axes) {
 RoughBody make_rough_mesh_body(const TriangleMesh& m, std::uint64_t n, const RadiusDistribution& radii, double density,
                                std::uint64_t seed, std::uint64_t body_id, const SurfaceMap& onto, std::string name) {
   validate(radii);
-  if (n < 1 || n > 0xffffffffull) throw std::invalid_argument("asperities must be in [1, 2^32-1], got " + std::to_string(n));
+  check_asperity_count(n);
   const MassProperties mp = mass_properties(m, density);
   std::vector<double> cum(m.faces.size());
   double acc = 0;

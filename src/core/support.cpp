@@ -49,8 +49,7 @@ void check_spans(std::span<const Vec3> c, std::span<const double> r) {
     throw std::invalid_argument("support query: " + std::to_string(c.size()) + " centres but " +
                                 std::to_string(r.size()) + " radii");
   if (c.empty()) throw std::invalid_argument("support query: a body needs at least one asperity, got 0");
-  if (c.size() > std::numeric_limits<std::uint32_t>::max())
-    throw std::invalid_argument("support query: at most 2^32-1 asperities, got " + std::to_string(c.size()));
+  check_asperity_count(c.size(), "support query: asperities");
 }
 
 class Tree final : public SupportQuery {

@@ -338,8 +338,7 @@ void validate(const MeshBounceExperiment& e) {
   } else if (!std::isfinite(e.sphere_radius) || !(e.sphere_radius > 0)) {
     throw std::invalid_argument("sphere radius must be finite and > 0 m, got " + num(e.sphere_radius));
   }
-  if (e.asperities < 1 || e.asperities > 0xffffffffull)
-    throw std::invalid_argument("asperities must be in [1, 2^32-1], got " + std::to_string(e.asperities));
+  check_asperity_count(e.asperities);
   validate(e.radii);
   if (!std::isfinite(e.density) || !(e.density > 0)) throw std::invalid_argument("density must be finite and > 0, got " + num(e.density));
   if (e.bodies < 1) throw std::invalid_argument("bodies must be >= 1, got 0");

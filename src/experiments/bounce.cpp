@@ -224,8 +224,7 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   p.J = 0.4 * p.mass * p.R * p.R;  // central sphere only (paper Sec. II)
   p.eps_n = en.get();
   const bool explicit_geometry = v == BounceVariant::random_orientation || v == BounceVariant::dynamic;
-  if (explicit_geometry && sphere.asperities > 0xFFFFFFFFull)
-    throw std::invalid_argument("bounce: asperities must be < 2^32, got " + std::to_string(sphere.asperities));
+  if (explicit_geometry) check_asperity_count(sphere.asperities, "bounce: asperities");
 
   BounceSamples s;
   s.variant = v;

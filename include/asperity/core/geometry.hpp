@@ -10,11 +10,18 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace asperity {
 
 using Vec3 = Eigen::Vector3d;
+
+/// Asperity indices are 32-bit (Nearest::index, support queries): a body carries 1 .. 2^32-1
+/// asperities. The one statement of that rule; check_asperity_count applies it.
+inline constexpr std::uint64_t kMaxAsperities = (std::uint64_t{1} << 32) - 1;
+/// Throws std::invalid_argument "<what> must be in [1, 2^32-1], got <n>" unless 1 <= n <= kMaxAsperities.
+void check_asperity_count(std::uint64_t n, std::string_view what = "asperities");
 
 /// Parameters of a rough sphere. All lengths in metres.
 struct SphereParams {
