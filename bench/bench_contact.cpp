@@ -19,7 +19,7 @@
 // Validation (always on, aborts with exit code 2): on a subsample (--validate, default 200) of the
 // timed random and rotating queries every backend must equal brute_lowest exactly; single, batch,
 // 1- and 2-thread answers must all be identical on every timed query.
-// Fresh mode: asperity::run_contact_ensemble(Mode::fresh) for --fresh-drops drops with 1 and 2
+// Fresh mode: asperity::run_contact_ensemble(Mode::sampled) for --fresh-drops drops with 1 and 2
 // threads per N (wall time of the whole call).
 //
 // --quick: seconds-long smoke run (N = 1e3, 1e4; 1 repeat; few queries). It checks the harness,
@@ -565,7 +565,7 @@ int main(int argc, char** argv) {
         for (int k = 0; k < o.repeats; ++k) {
           asperity::EnsembleConfig cfg;
           cfg.sphere = p;
-          cfg.mode = asperity::Mode::fresh;
+          cfg.mode = asperity::Mode::sampled;
           cfg.drops = o.fresh_drops;
           cfg.seed = o.seed;
           cfg.threads = t;
@@ -647,7 +647,7 @@ int main(int argc, char** argv) {
   for (const auto n : o.sizes) std::cout << "| " << size_name(n) << " | " << sig3(gen_s[n]) << " | " << sig3(gen1_s[n]) << " |\n";
 
   if (o.fresh) {
-    std::cout << "\n## Fresh mode (run_contact_ensemble, Mode::fresh, " << o.fresh_drops
+    std::cout << "\n## Fresh mode (run_contact_ensemble, Mode::sampled, " << o.fresh_drops
               << " drops, wall time of the call)\n\n| N | drops/s 1T | drops/s 2T | 2T/1T |\n|---:|---:|---:|---:|\n";
     for (const auto& f : fresh)
       std::cout << "| " << size_name(f.n) << " | " << sig3(f.rate1) << " | " << sig3(f.rate2) << " | "

@@ -96,7 +96,7 @@ void scan_or_index(std::uint64_t n, std::uint64_t spheres, const std::vector<std
   for (const auto m : rotations) {
     EnsembleConfig c;
     c.sphere.asperities = n;
-    c.mode = Mode::fixed;
+    c.mode = Mode::explicit_spheres;
     c.spheres = spheres;
     c.drops = std::max<std::uint64_t>(2, spheres * m);
     std::vector<double> tb, tg;

@@ -4,11 +4,13 @@
 // exact_sphere_rxy(N, R): KS distance D, and the z-scores of the sample mean and std.
 //
 // Strategies:
-//   fresh-cap              EnsembleConfig fresh (O(1) cap per drop)
+//   sampled                Mode::sampled: drawn from the exact finite-N law of the lowest
+//                          asperity (O(1) per drop), no geometry: the theory cross-check and
+//                          speed baseline of the explicit designs below
 //   fresh-full             every drop a new explicit sphere + random rotation + brute (O(N)/drop)
-//   fixed-B-1sphere        one sphere, n rotations, for every backend B (brute, kdtree, cgal,
-//                          fcl, grid): the same answers, different time axes
-//   fixed-B-Kspheres       K = 100 spheres x n/100 rotations, every backend B
+//   fixed-B-1sphere        explicit: one sphere, n rotations, for every backend B (brute, kdtree,
+//                          cgal, fcl, grid): the same answers, different time axes
+//   fixed-B-Kspheres       explicit: K = 100 spheres x n/100 rotations, every backend B
 //   paper-sampling         r_xy drawn from the paper's closed-form Rayleigh law (Eq. 14) by
 //                          inverse cdf: the speed baseline; its error holds Eq. 14's model error
 //
@@ -249,17 +251,17 @@ int main(int argc, char** argv) {
          }
          return x;
        }},
-      {"fresh-cap", 1, [&](std::uint64_t n) { return ensemble(Mode::fresh, Backend::grid, n, 1); }},
-      {"fresh-full", 1, [&](std::uint64_t n) { return ensemble(Mode::fixed, Backend::brute, n, n); }},
+      {"sampled", 1, [&](std::uint64_t n) { return ensemble(Mode::sampled, Backend::grid, n, 1); }},
+      {"fresh-full", 1, [&](std::uint64_t n) { return ensemble(Mode::explicit_spheres, Backend::brute, n, n); }},
   };
   // Every backend answers the same query exactly, so their error curves coincide for a given
   // sphere: what differs is the time axis.
   for (const Backend b : all_backends()) {
     const std::string name(to_string(b));
     strategies.push_back({"fixed-" + name + "-1sphere", 1,
-                          [&, b](std::uint64_t n) { return ensemble(Mode::fixed, b, n, 1); }});
+                          [&, b](std::uint64_t n) { return ensemble(Mode::explicit_spheres, b, n, 1); }});
     strategies.push_back({"fixed-" + name + "-Kspheres", K,
-                          [&, b](std::uint64_t n) { return ensemble(Mode::fixed, b, n, K); }});
+                          [&, b](std::uint64_t n) { return ensemble(Mode::explicit_spheres, b, n, K); }});
   }
 
   if (!o.only.empty()) {

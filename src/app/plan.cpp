@@ -20,19 +20,24 @@ Plan make_plan(const Scene& s) {
   Plan p;
   p.scene = s;
   auto& e = p.scene.ensemble;
-  const bool fixed = e.mode == Mode::fixed;
+  const bool fixed = e.mode == Mode::explicit_spheres;
+  if (fixed && s.spheres_auto) e.spheres = auto_spheres(e.sphere.asperities, e.drops);
   const std::uint64_t rotations = fixed ? e.drops / e.spheres : 1;
   if (fixed && s.backend_auto) e.backend = rotations < kScanBelowRotations ? Backend::brute : Backend::grid;
 
   const std::string n = std::to_string(e.sphere.asperities);
   if (fixed)
-    p.stages.push_back({"generate", true, std::to_string(e.spheres) + " explicit sphere(s) of " + n + " asperities"});
+    p.stages.push_back({"generate", true,
+                        std::to_string(e.spheres) + " explicit sphere(s) of " + n + " asperities" +
+                            (s.spheres_auto ? " (spheres auto: error budget M <= N/(10 c^2) rotations per sphere, K >= " +
+                                                  std::to_string(kAutoMinSpheres) + ")"
+                                            : std::string())});
   else
     p.stages.push_back({"generate", false,
-                        "fresh mode: each drop draws only its lowest asperities (exact order statistics); no sphere is built"});
+                        "sampled: each drop draws its lowest asperities from the exact finite-N law; no sphere is built"});
 
   if (!fixed) {
-    p.stages.push_back({"index", false, "fresh mode: no sphere, no index"});
+    p.stages.push_back({"index", false, "sampled: no sphere, no index"});
   } else if (e.backend == Backend::brute) {
     p.stages.push_back(
         {"index", false,
@@ -46,7 +51,15 @@ Plan make_plan(const Scene& s) {
                                                   std::to_string(kScanBelowRotations)
                                             : std::string())});
   }
-  p.stages.push_back({"query", true, "lowest asperity of each of " + std::to_string(e.drops) + " drops"});
+  p.stages.push_back({"query", true,
+                      "lowest asperity of each of " + std::to_string(e.drops) + " drops" +
+                          (fixed ? std::string(" by spatial query") : std::string(" (exact sampler, no geometry)"))});
+  if (fixed)
+    p.stages.push_back({"cross_check", true,
+                        "a deterministic subsample of the queries answered again by brute force and the kd-tree (and FCL "
+                        "where built and N is small)"});
+  else
+    p.stages.push_back({"cross_check", false, "sampled: no spatial queries to check"});
 
   const bool impact = e.impact.enabled && s.restitution_stats;
   if (impact)

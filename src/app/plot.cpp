@@ -25,7 +25,9 @@
 #include <limits>
 #include <locale>
 #include <random>
+#include <exception>
 #include <sstream>
+#include <thread>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -270,7 +272,7 @@ std::string build_script(const HistogramFigure& fig, const fs::path& out) {
 
   // Legend entry for the data first, then the curves, then the data drawn on top without a title.
   const std::string data_title =
-      "explicit geometry (n = " + format_count(h.total) + ")";
+      fig.data_label + " (n = " + format_count(h.total) + ")";
   auto plot_cmd = [&](bool log_panel) {
     s << "plot NaN with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 title "
       << gp_text(data_title);
@@ -407,11 +409,25 @@ void write_gnuplot_png(const fs::path& png, const std::function<std::string(cons
 }
 
 std::vector<std::string> write_figures(const fs::path& dir, const std::vector<NamedFigure>& figures) {
-  std::vector<std::string> names;
-  for (const auto& f : figures) {
-    write_histogram_png(dir / f.file, f.figure);
-    names.push_back(f.file);
+  // Each figure is its own gnuplot process: run them concurrently (gnuplot is single-threaded and
+  // spends most of its time starting up and rendering), then report the first failure in order.
+  std::vector<std::exception_ptr> errors(figures.size());
+  {
+    std::vector<std::thread> workers;
+    for (std::size_t i = 0; i < figures.size(); ++i)
+      workers.emplace_back([&, i] {
+        try {
+          write_histogram_png(dir / figures[i].file, figures[i].figure);
+        } catch (...) {
+          errors[i] = std::current_exception();
+        }
+      });
+    for (auto& w : workers) w.join();
   }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);  // the run's own cleanup removes the figures it wrote
+  std::vector<std::string> names;
+  for (const auto& f : figures) names.push_back(f.file);
   return names;
 }
 

@@ -43,7 +43,6 @@ constexpr double kPerAsperityMesh = 108;  // a mesh body's asperity: centre, rad
 constexpr double kPerDropMesh = 68;
 constexpr double kPerImpactBounce = 64;   // one impact of a bounce sequence, kept for the analysis
 constexpr double kImpactsPerDecade = 55.5;  // fig6: 55.5 impacts from 1 m/s down to 0.1 m/s
-constexpr std::uint64_t kChunk = 4096;    // ensemble.cpp: rotations per batch
 
 int threads_of(const Scene& s) {
   if (s.ensemble.threads > 0) return s.ensemble.threads;
@@ -76,18 +75,15 @@ MemoryEstimate estimate_memory(const Scene& s) {
     case RunKind::sphere: {
       const Plan plan = make_plan(s);
       const auto& pe = plan.scene.ensemble;
-      double per_drop = pe.mode == Mode::fresh ? kPerDropFresh : kPerDropFixed;
+      double per_drop = pe.mode == Mode::sampled ? kPerDropFresh : kPerDropFixed;
       if (pe.impact.enabled) per_drop = kPerDropImpact;
       m.bytes = kBaseSphere + per_drop * n;
       d << count(e.drops) << " drops x " << per_drop << " B";
-      if (pe.mode == Mode::fixed) {
-        // Few large batches: one sphere at a time; many small spheres: one per busy thread, each
-        // thread taking 4 spheres at a time (ensemble.cpp).
-        const std::uint64_t per_sphere = e.drops / std::max<std::uint64_t>(1, e.spheres);
+      if (pe.mode == Mode::explicit_spheres) {
+        // One sphere: its rotations in parallel; K > 1 spheres: one sphere per busy thread
+        // (ensemble.cpp), K from the plan (the error budget when spheres = "auto").
         const double concurrent =
-            per_sphere >= kChunk || e.spheres == 1
-                ? 1.0
-                : double(std::min<std::uint64_t>(std::uint64_t(threads_of(s)), (e.spheres + 3) / 4));
+            pe.spheres <= 1 ? 1.0 : double(std::min<std::uint64_t>(std::uint64_t(threads_of(s)), pe.spheres));
         const double b = per_asperity(pe.backend);
         m.bytes += concurrent * N * b;
         d << " + " << fmt(concurrent) << " sphere(s) at once (--threads " << threads_of(s) << ") x " << count(e.sphere.asperities)

@@ -257,7 +257,8 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
   o.files = r.plots;
   o.rejected = r.rejected();
   for (const auto& t : r.tests)
-    if (t.decisive && t.verdict == "skipped") o.skipped.push_back(t.quantity + " " + t.law + " (" + t.scope + "): " + t.note);
+    if (t.decisive && (t.verdict == "skipped" || t.verdict == "undecided"))
+      o.skipped.push_back(t.quantity + " " + t.law + " (" + t.verdict + "): " + t.note);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = r.scene.name;
@@ -288,6 +289,7 @@ GeometryReport run_scene(const Scene& s, const Progress& progress, const std::fi
   plan.stage("generate").seconds = samples.seconds_generate;
   plan.stage("index").seconds = samples.seconds_index;
   plan.stage("query").seconds = samples.seconds_query;
+  if (plan.runs("cross_check")) plan.stage("cross_check").seconds = samples.cross_check.seconds;
   plan.stage("impact").seconds = samples.seconds_impact;
   r.plan = std::move(plan.stages);
   r.scene_toml = to_toml(s);

@@ -112,8 +112,8 @@ void validate(const Scene& s) {
   if (s.radii) validate(s.radii->radii);
   if (s.mesh) {
     if (s.mesh->file.empty()) throw std::invalid_argument("mesh file must not be empty");
-    if (s.ensemble.mode != Mode::fixed)
-      throw std::invalid_argument("a mesh body needs mode fixed (explicit bodies x rotations), got " +
+    if (s.ensemble.mode != Mode::explicit_spheres)
+      throw std::invalid_argument("a mesh body needs mode explicit (explicit bodies x rotations), got " +
                                   std::string(to_string(s.ensemble.mode)));
     if (s.ensemble.impact.enabled == s.bounce.enabled)
       throw std::invalid_argument("a mesh body runs single impacts or bounce sequences: it needs an impact or a bounce "
@@ -138,8 +138,8 @@ void validate(const Scene& s) {
                            : d.kind == RadiusDistribution::Kind::lognormal ? d.median : d.radius;
     if (!(top < R))
       throw std::invalid_argument("asperity radii " + d.describe() + " must be smaller than radius = " + detail::num(R) + " m");
-    if (s.ensemble.mode != Mode::fresh)
-      throw std::invalid_argument("unequal asperity radii on a sphere need mode fresh, got " +
+    if (s.ensemble.mode != Mode::sampled)
+      throw std::invalid_argument("unequal asperity radii on a sphere need mode sampled (their exact sampler), got " +
                                   std::string(to_string(s.ensemble.mode)));
     if (s.ensemble.impact.enabled || s.bounce.enabled)
       throw std::invalid_argument("unequal asperity radii on a sphere are analysed as contacts only (no impacts)");

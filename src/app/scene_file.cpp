@@ -422,15 +422,27 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   // [ensemble]
   auto& e = s.ensemble;
   if (auto ens = top.table("ensemble")) {
-    if (auto m = ens->choice("mode", {"fresh", "fixed"})) e.mode = parse_mode(*m);
-    if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
-    if (auto k = ens->count("spheres", 1, kMaxDrops)) {
-      if (e.mode == Mode::fresh && *k != 1)
-        ens->bad("spheres", "only mode = \"fixed\" uses explicit spheres (fresh mode draws a new sphere per drop), got " +
-                                std::to_string(*k));
-      e.spheres = *k;
+    // Earlier names: "fixed" is "explicit"; "fresh" is "explicit" (the paper's sphere: validated from
+    // geometry, with a note) or "sampled" (unequal radii: their exact sampler, as before).
+    if (auto m = ens->choice("mode", {"explicit", "sampled", "fresh", "fixed"})) {
+      e.mode = parse_mode(*m);
+      if (*m == "fresh" && s.radii && !s.mesh) e.mode = Mode::sampled;
+      else if (is_legacy_mode(*m)) s.legacy_mode = *m;
+    } else if (s.radii && !s.mesh) {
+      e.mode = Mode::sampled;  // unequal radii on a sphere: the exact sampler is their only design
     }
-    if (e.mode == Mode::fixed && e.drops % e.spheres != 0)
+    if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
+    const toml::node* k_node = ens->has("spheres") ? ens->find("spheres") : nullptr;
+    if (k_node && k_node->as_string() && k_node->as_string()->get() == "auto") {
+      s.spheres_auto = true;
+    } else if (auto k = ens->count("spheres", 1, kMaxDrops)) {
+      if (e.mode == Mode::sampled && *k != 1)
+        ens->bad("spheres", "only mode = \"explicit\" uses explicit spheres (sampled draws from the exact law, no sphere), "
+                            "got " + std::to_string(*k));
+      e.spheres = *k;
+      s.spheres_auto = e.mode != Mode::explicit_spheres;
+    }
+    if (e.mode == Mode::explicit_spheres && !s.spheres_auto && e.drops % e.spheres != 0)
       ens->bad("drops", std::to_string(e.drops) + " must be a multiple of ensemble.spheres = " + std::to_string(e.spheres));
     if (const toml::node* seed = ens->find("seed")) {
       // Integers up to 2^63 - 1; larger 64-bit seeds as a string of digits.
@@ -449,9 +461,9 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     if (auto b = ens->choice("backend", {"auto", "brute", "kdtree", "cgal", "fcl", "grid"})) {
       s.backend_auto = *b == "auto";
       if (!s.backend_auto) e.backend = parse_backend(*b);
-      if (e.mode == Mode::fresh && !s.backend_auto)  // a key that cannot apply is refused, never ignored
-        ens->bad("backend", "only mode = \"fixed\" queries a contact index (fresh mode draws the lowest asperities "
-                            "exactly): \"auto\" or absent, got \"" + *b + "\"");
+      if (e.mode == Mode::sampled && !s.backend_auto)  // a key that cannot apply is refused, never ignored
+        ens->bad("backend", "only mode = \"explicit\" queries a contact index (sampled draws the lowest asperities "
+                            "from the exact law): \"auto\" or absent, got \"" + *b + "\"");
     }
     if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
     ens->finish();
@@ -459,13 +471,15 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
 
   // Mesh bodies and unequal radii are runs of body_experiments.hpp: explicit bodies with the exact
   // support tree, so the ensemble keys that choose a contact backend or a mode do not apply.
-  if (s.mesh && e.mode != Mode::fixed)
+  // Bodies, radii and bounce runs choose their own number of bodies: K is never automatic there.
+  if (s.mesh || s.radii || s.bounce.enabled) s.spheres_auto = false;
+  if (s.mesh && e.mode != Mode::explicit_spheres)
     top.fail(nullptr, "ensemble.mode",
-             "ensemble.mode: a mesh body needs mode = \"fixed\" (ensemble.spheres explicit bodies x rotations), got \"" +
+             "ensemble.mode: a mesh body needs mode = \"explicit\" (ensemble.spheres explicit bodies x rotations), got \"" +
                  std::string(to_string(e.mode)) + "\"");
-  if (s.radii && !s.mesh && e.mode != Mode::fresh)
+  if (s.radii && !s.mesh && e.mode != Mode::sampled)
     top.fail(nullptr, "ensemble.mode",
-             "ensemble.mode: unequal asperity radii on a sphere draw fresh spheres (mode = \"fresh\") and screen "
+             "ensemble.mode: unequal asperity radii on a sphere draw from their exact sampler (mode = \"sampled\") and screen "
              "[screening] bodies explicit ones, got \"" + std::string(to_string(e.mode)) + "\"");
   if ((s.mesh || s.radii) && !s.backend_auto)
     top.fail(nullptr, "ensemble.backend",
@@ -550,6 +564,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     ex->finish();
   }
   impact.enabled = impacts;
+  if (s.bounce.enabled || s.mesh) s.spheres_auto = false, s.legacy_mode.clear();  // their own designs
   if (s.mesh && !impacts && !s.bounce.enabled)
     top.fail(nullptr, "experiment.kind",
              "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega) or \"bounce\"");
@@ -795,14 +810,21 @@ std::string to_toml(const Scene& s) {
   }
   if (s.radii)
     os << "[screening]\nbodies = " << s.radii->screen_bodies << "\ndirections = " << s.radii->screen_directions << "\n\n";
-  os << "[ensemble]\nmode = \"" << to_string(e.mode) << "\"\ndrops = " << e.drops << "\n";
-  if (e.mode == Mode::fixed) os << "spheres = " << e.spheres << "\n";  // fresh mode has no explicit spheres
+  // A scene that named a mode by its earlier name is written as it was named (it runs as explicit).
+  os << "[ensemble]\nmode = \"" << (s.legacy_mode.empty() ? to_string(e.mode) : std::string_view(s.legacy_mode))
+     << "\"\ndrops = " << e.drops << "\n";
+  if (e.mode == Mode::explicit_spheres) {  // sampled drops have no explicit spheres
+    if (s.spheres_auto)
+      os << "spheres = \"auto\"\n";
+    else
+      os << "spheres = " << e.spheres << "\n";
+  }
   os << "seed = ";
   if (e.seed > static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max()))
     os << quote(std::to_string(e.seed));
   else
     os << e.seed;
-  os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::fresh ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
+  os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::sampled ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
      << e.threads << "\n\n";
   if (s.bounce.enabled) {
     const auto& b = s.bounce;

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "asperity/config.hpp"
 #include "asperity/core/impact.hpp"
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
@@ -19,12 +20,40 @@ namespace asperity {
 
 using detail::num;
 
-std::string_view to_string(Mode m) { return m == Mode::fresh ? "fresh" : "fixed"; }
+std::string_view to_string(Mode m) { return m == Mode::explicit_spheres ? "explicit" : "sampled"; }
 
 Mode parse_mode(std::string_view s) {
-  if (s == "fresh") return Mode::fresh;
-  if (s == "fixed") return Mode::fixed;
-  throw std::invalid_argument("unknown mode '" + std::string(s) + "' (expected fresh or fixed)");
+  if (s == "explicit" || s == "fixed" || s == "fresh") return Mode::explicit_spheres;
+  if (s == "sampled") return Mode::sampled;
+  throw std::invalid_argument("unknown mode '" + std::string(s) +
+                              "' (expected explicit or sampled; fixed and fresh are read as explicit)");
+}
+
+bool is_legacy_mode(std::string_view s) { return s == "fresh" || s == "fixed"; }
+
+std::string legacy_mode_note(std::string_view legacy) {
+  if (legacy == "fixed") return "mode \"fixed\" (earlier name) runs as \"explicit\": K explicit spheres x M rotations.";
+  return "mode \"fresh\" (earlier name: it drew the lowest asperities from the exact law, no geometry) runs as "
+         "\"explicit\": K explicit spheres x M rotations, contacts by spatial query; mode \"sampled\" is the old "
+         "sampler.";
+}
+
+std::uint64_t auto_spheres(std::uint64_t asperities, std::uint64_t drops) {
+  if (drops <= kAutoMinSpheres) return drops;
+  const double c2 = kQuenchedKs * kQuenchedKs;
+  const auto m_max = static_cast<std::uint64_t>(std::max(1.0, std::floor(double(asperities) / (10.0 * c2))));
+  const std::uint64_t k_min = std::max<std::uint64_t>(kAutoMinSpheres, (drops + m_max - 1) / m_max);
+  for (std::uint64_t k = k_min; k < drops; ++k)
+    if (drops % k == 0) return k;
+  return drops;
+}
+
+DesignScales design_scales(Mode mode, std::uint64_t asperities, std::uint64_t spheres, std::uint64_t drops) {
+  DesignScales s;
+  s.statistical = 0.8687 / std::sqrt(double(drops));  // mean of sqrt(n) D under iid: sqrt(pi/2) ln 2
+  if (mode == Mode::explicit_spheres)
+    s.quenched = kQuenchedKs / std::sqrt(double(asperities) * double(std::max<std::uint64_t>(spheres, 1)));
+  return s;
 }
 
 void validate(const EnsembleConfig& c) {
@@ -33,7 +62,7 @@ void validate(const EnsembleConfig& c) {
     throw std::invalid_argument("drops must be >= 2 (a standard error needs two samples), got " + std::to_string(c.drops));
   if (c.drops > (std::uint64_t{1} << 31))
     throw std::invalid_argument("drops must be <= 2^31, got " + std::to_string(c.drops));
-  if (c.mode == Mode::fixed) {
+  if (c.mode == Mode::explicit_spheres) {
     if (c.spheres < 1) throw std::invalid_argument("spheres must be >= 1, got 0");
     if (c.drops % c.spheres != 0)
       throw std::invalid_argument("drops (" + std::to_string(c.drops) + ") must be a multiple of spheres (" +
@@ -194,6 +223,50 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
 
 }  // namespace
 
+namespace {
+
+// Cross-check of one sphere's sampled queries by other exact backends (CrossCheck, ensemble.hpp).
+struct SphereCheck {
+  std::uint64_t queries = 0, agreed = 0;
+  std::string first_disagreement;
+};
+
+SphereCheck cross_check_sphere(const EnsembleConfig& c, std::span<const Vec3> centres,
+                               const std::vector<std::pair<Vec3, Nearest>>& answers,
+                               const std::vector<Backend>& others, std::uint64_t sphere) {
+  SphereCheck r;
+  std::vector<std::unique_ptr<ContactQuery>> idx;
+  for (Backend b : others)
+    if (b != Backend::brute) idx.push_back(make_contact_query(b, centres));
+  for (const auto& [d, main] : answers) {
+    ++r.queries;
+    bool ok = brute_lowest(centres, d) == main;
+    for (const auto& q : idx) ok = ok && q->lowest(d) == main;
+    if (ok) {
+      ++r.agreed;
+    } else if (r.first_disagreement.empty()) {
+      r.first_disagreement = "sphere " + std::to_string(sphere) + ", direction (" + num(d.x()) + ", " + num(d.y()) +
+                             ", " + num(d.z()) + "): backend " + std::string(to_string(c.backend)) + " answered asperity " +
+                             std::to_string(main.index) + ", brute force " + std::to_string(brute_lowest(centres, d).index);
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+std::vector<Backend> cross_check_backends(Backend main, std::uint64_t asperities) {
+  std::vector<Backend> b;
+  for (Backend x : {Backend::brute, Backend::kdtree})
+    if (x != main) b.push_back(x);
+#if ASPERITY_WITH_FCL
+  if (main != Backend::fcl && asperities <= kCrossCheckFclMax) b.push_back(Backend::fcl);
+#else
+  (void)asperities;
+#endif
+  return b;
+}
+
 ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& user_progress) {
   validate(c);
   GuardedProgress progress(user_progress);
@@ -204,7 +277,7 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
   const double R = c.sphere.radius, a = c.sphere.asperity_radius;
   const std::uint64_t n = c.sphere.asperities;
 
-  if (c.mode == Mode::fresh) {
+  if (c.mode == Mode::sampled) {
     s.batches = c.drops;
     const auto t0 = Clock::now();
     for_chunks(c.drops, 0, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
@@ -219,10 +292,23 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
     s.seconds_query = since(t0);
   } else {
     s.batches = c.spheres;
-    const std::uint64_t m = c.drops / c.spheres;
-    // Rotations of sphere k, drops [k m + b, k m + e): the same streams whichever loop runs them.
+    const std::uint64_t K = c.spheres, m = c.drops / K;
+    // Cross-check plan: spheres 0 and K-1, every `stride`-th rotation of each.
+    const std::vector<Backend> others = cross_check_backends(c.backend, n);
+    const double budget = std::max(100.0, std::floor(kCrossCheckScanBudget / double(n)));
+    const auto total_checks = static_cast<std::uint64_t>(
+        std::min({double(c.drops), 1e4, std::max(100.0, std::min(0.01 * double(c.drops), budget))}));
+    // Spheres 0, s, 2s, ...: as many as the quota needs (one when a sphere has enough rotations: each
+    // checked sphere costs a kd-tree build, ~25 ms at N = 10^5).
+    const std::uint64_t check_spheres = std::min<std::uint64_t>(K, (total_checks + m - 1) / m);
+    const std::uint64_t sphere_stride = K / check_spheres;
+    const std::uint64_t per_sphere = std::max<std::uint64_t>(1, (total_checks + check_spheres - 1) / check_spheres);
+    const std::uint64_t stride = std::max<std::uint64_t>(1, m / per_sphere);
+    auto is_checked = [&](std::uint64_t k) { return k % sphere_stride == 0 && k / sphere_stride < check_spheres; };
+
+    // Rotations [b, e) of sphere k, drops [k m + b, k m + e): the same streams whichever loop runs them.
     auto rotate = [&](const RoughSphere& body, const ContactQuery& index, std::uint64_t k, std::uint64_t b,
-                      std::uint64_t e) {
+                      std::uint64_t e, std::vector<std::pair<Vec3, Nearest>>* checks) {
       std::vector<Rotation> q(e - b);
       std::vector<Vec3> d(e - b);
       std::vector<Nearest> nn(e - b);
@@ -235,32 +321,44 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
       for (std::uint64_t j = b; j < e; ++j) {
         const Nearest& r = nn[j - b];
         store(s, k * m + j, make_contact(r, body.centres[r.index], q[j - b], R, a));
+        if (checks && j % stride == 0 && checks->size() < per_sphere) checks->emplace_back(d[j - b], r);
       }
     };
-    if (m >= kChunk || c.spheres == 1) {
-      // Few large batches: one sphere at a time, its rotations in parallel.
-      for (std::uint64_t k = 0; k < c.spheres; ++k) {
-        auto t0 = Clock::now();
-        const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
-        s.seconds_generate += since(t0);
-        t0 = Clock::now();
-        const auto index = make_contact_query(c.backend, body.centres);
-        s.seconds_index += since(t0);
-        s.index_bytes = index->memory_bytes();
-        t0 = Clock::now();
-        for_chunks(m, k * m, c.drops, progress,
-                   [&](std::uint64_t b, std::uint64_t e) { rotate(body, *index, k, b, e); });
-        s.seconds_query += since(t0);
-      }
+    std::vector<SphereCheck> checks(check_spheres);
+    auto check_slot = [&](std::uint64_t k) -> SphereCheck& { return checks[k / sphere_stride]; };
+    double seconds_check = 0;
+    if (K == 1) {
+      // One sphere: its rotations in parallel.
+      auto t0 = Clock::now();
+      const RoughSphere body = make_rough_sphere(c.sphere, c.seed, 0);
+      s.seconds_generate += since(t0);
+      t0 = Clock::now();
+      const auto index = make_contact_query(c.backend, body.centres);
+      s.seconds_index += since(t0);
+      s.index_bytes = index->memory_bytes();
+      t0 = Clock::now();
+      std::vector<std::vector<std::pair<Vec3, Nearest>>> found((m + kChunk - 1) / kChunk);
+      for_chunks(m, 0, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
+        rotate(body, *index, 0, b, e, &found[b / kChunk]);
+      });
+      s.seconds_query += since(t0);
+      t0 = Clock::now();
+      std::vector<std::pair<Vec3, Nearest>> answers;
+      for (const auto& f : found)
+        for (const auto& x : f)
+          if (answers.size() < per_sphere) answers.push_back(x);
+      checks[0] = cross_check_sphere(c, body.centres, answers, others, 0);
+      seconds_check = since(t0);
     } else {
-      // Many small spheres: spheres in parallel, each built and queried by one thread (no
-      // parallel region per sphere). Stage times are then summed over threads.
+      // Spheres in parallel, each generated, indexed and queried by one thread: no parallel region
+      // per sphere (OpenMP barriers cost much on a shared machine). Stage times are summed over
+      // threads; `query` is the wall time of the whole loop.
       const auto t0 = Clock::now();
-      const std::int64_t spheres = static_cast<std::int64_t>(c.spheres);
+      const std::int64_t spheres = static_cast<std::int64_t>(K);
       std::atomic<std::uint64_t> done{0};
-      double gen = 0, idx = 0;
+      double gen = 0, idx = 0, chk = 0;
       std::size_t bytes = 0;
-#pragma omp parallel for schedule(dynamic, 4) reduction(+ : gen, idx) reduction(max : bytes)
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : gen, idx, chk) reduction(max : bytes)
       for (std::int64_t kk = 0; kk < spheres; ++kk) {
         const auto k = static_cast<std::uint64_t>(kk);
         if (progress.stopped()) continue;
@@ -271,14 +369,33 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
         const auto index = make_contact_query(c.backend, body.centres);
         idx += since(t);
         bytes = std::max(bytes, index->memory_bytes());
-        rotate(body, *index, k, 0, m);
+        std::vector<std::pair<Vec3, Nearest>> answers;
+        for (std::uint64_t b = 0; b < m; b += kChunk)
+          rotate(body, *index, k, b, std::min(m, b + kChunk), is_checked(k) ? &answers : nullptr);
+        if (is_checked(k)) {
+          t = Clock::now();
+          check_slot(k) = cross_check_sphere(c, body.centres, answers, others, k);
+          chk += since(t);
+        }
         const std::uint64_t now = done.fetch_add(m) + m;
         if (omp_get_thread_num() == 0) progress(now, c.drops);
       }
       progress.rethrow();
       s.seconds_generate = gen, s.seconds_index = idx, s.index_bytes = bytes;
       s.seconds_query = since(t0);  // wall time of the whole loop, generation and indexing included
+      seconds_check = chk;
     }
+    s.cross_check.seconds = seconds_check;
+    for (Backend b : others) s.cross_check.backends.emplace_back(to_string(b));
+    for (const auto& ch : checks) {
+      s.cross_check.queries += ch.queries;
+      s.cross_check.agreed += ch.agreed;
+    }
+    for (const auto& ch : checks)
+      if (!ch.first_disagreement.empty())
+        throw std::runtime_error("cross-check failed: " + std::to_string(s.cross_check.queries - s.cross_check.agreed) +
+                                 " of " + std::to_string(s.cross_check.queries) +
+                                 " re-answered queries disagree with the run's backend; first: " + ch.first_disagreement);
   }
   s.core_contacts = static_cast<std::uint64_t>(std::count(s.core.begin(), s.core.end(), std::uint8_t{1}));
   if (c.impact.enabled) run_impacts(c, s);

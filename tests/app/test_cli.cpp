@@ -87,8 +87,22 @@ TEST(Cli, GoodRunWritesTheReportContract) {
   EXPECT_NE(r.out.find("verdict"), std::string::npos);
   std::ifstream f(out / "report.json");
   const auto j = nlohmann::json::parse(f);
-  EXPECT_EQ(j.at("mode"), "fresh");
+  EXPECT_EQ(j.at("mode"), "explicit");
   EXPECT_EQ(j.at("samples"), 20000);
+  // The design and its error budget, and the cross-check of the run's own queries.
+  const auto& d = j.at("design");
+  EXPECT_EQ(d.at("kind"), "explicit");
+  EXPECT_EQ(d.at("spheres").get<std::uint64_t>() * d.at("rotations_per_sphere").get<std::uint64_t>(), 20000u);
+  EXPECT_EQ(d.at("backend"), "grid");
+  for (const char* k : {"statistical_scale", "quenched_scale", "model_error_scale"}) EXPECT_GT(d.at(k).get<double>(), 0) << k;
+  EXPECT_LT(d.at("quenched_scale").get<double>(), d.at("statistical_scale").get<double>());
+  const auto& cc = j.at("cross_check");
+  EXPECT_GE(cc.at("queries").get<int>(), 100);
+  EXPECT_EQ(cc.at("agreed"), cc.at("queries"));
+  const auto backends = cc.at("backends").get<std::vector<std::string>>();
+  for (const char* b : {"brute", "kdtree"})
+    EXPECT_NE(std::find(backends.begin(), backends.end(), b), backends.end()) << b;
+  EXPECT_NE(r.out.find("explicit geometry: "), std::string::npos);
   EXPECT_TRUE(j.at("core_contacts").is_number_unsigned());
   EXPECT_EQ(j.at("parameters").at("asperities"), 1000);
   EXPECT_EQ(j.at("parameters").at("radius_m"), 3e-3);
@@ -110,12 +124,26 @@ TEST(Cli, GoodRunWritesTheReportContract) {
 }
 
 TEST(Cli, ARejectedLawExitsWith1) {
-  // With N = 3 the flat-cap Poisson law of Eq. 14 is plainly wrong (the cap is the whole sphere):
-  // 20000 drops reject it (the exact law is accepted).
+  // With N = 5 the Gaussian of Eq. 18 (and Eq. 14's flat cap) is plainly wrong: the explicit
+  // default design with 2x10^4 drops rejects it by its decisive test and exits 1.
   const fs::path out = fresh_dir("reject");
-  const CliRun r = run("--asperities 3 --drops 20000 --no-plots --out " + out.string());
+  const CliRun r = run("--asperities 5 --drops 20000 --no-plots --out " + out.string());
   EXPECT_EQ(r.status, 1) << r.out;
-  EXPECT_NE(r.out.find("reject"), std::string::npos);
+  std::ifstream f(out / "report.json");
+  const auto j = nlohmann::json::parse(f);
+  bool eq18_rejected = false;
+  for (const auto& t : j.at("tests"))
+    if (t.at("law") == "eq18" && t.at("decisive") == true && t.at("verdict") == "reject") eq18_rejected = true;
+  EXPECT_TRUE(eq18_rejected) << r.out;
+  fs::remove_all(out);
+}
+
+TEST(Cli, OneSphereIsReportedAsItsOwnLawAndDecidesNothing) {
+  const fs::path out = fresh_dir("onesphere");
+  const CliRun r = run("--asperities 200 --spheres 1 --drops 50000 --no-plots --out " + out.string());
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("not-decisive"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(" accept\n"), std::string::npos) << r.out;
   fs::remove_all(out);
 }
 
@@ -159,8 +187,8 @@ TEST(CliScene, ATinySceneWritesAReportWithItsPlan) {
     if (st.at("run").get<bool>()) EXPECT_GE(st.at("seconds").get<double>(), 0.0);
     else EXPECT_TRUE(st.at("seconds").is_null());
   }
-  EXPECT_EQ(run_stages, (std::set<std::string>{"query", "analysis"}));
-  EXPECT_EQ(skipped, (std::set<std::string>{"generate", "index", "impact", "plots"}));
+  EXPECT_EQ(run_stages, (std::set<std::string>{"generate", "index", "query", "cross_check", "analysis"}));
+  EXPECT_EQ(skipped, (std::set<std::string>{"impact", "plots"}));
   for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
   EXPECT_NE(j.at("scene_file").get<std::string>().find("count = 500"), std::string::npos);
   for (const auto& e : fs::directory_iterator(out))  // the table is named after the report
@@ -380,11 +408,11 @@ TEST(CliReport, AsperityRadiusOverridesLevelRadii) {
 
 // An option that cannot apply to the scene's kind of run is an error naming the option and why,
 // with exit status 2 and nothing written; never silently ignored.
-// --mode fresh on a fixed scene with a chosen backend: the backend no longer applies, so the
-// effective scene says "auto" (and reads back: a fresh scene file naming a backend is an error).
-TEST(CliReport, ModeFreshDropsTheFilesBackend) {
+// --mode sampled on a scene with a chosen backend: the backend no longer applies, so the
+// effective scene says "auto" (and reads back: a sampled scene file naming a backend is an error).
+TEST(CliReport, ModeSampledDropsTheFilesBackend) {
   const fs::path out = fresh_dir("fresh-backend");
-  const CliRun r = run("--preset fig3-fixed --mode fresh --asperities 1000 --drops 2000 --no-plots --out " +
+  const CliRun r = run("--preset fig3-fixed --mode sampled --asperities 1000 --drops 2000 --no-plots --out " +
                        out.string());
   ASSERT_EQ(r.status, 0) << r.out;
   const auto j = read_report(out / "report.json");
@@ -399,8 +427,8 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
   const fs::path lv = levels_scene(out), mesh = mesh_scene(out);
   const std::string L = "--scene " + lv.string(), M = "--scene " + mesh.string();
   const std::vector<Bad> cases = {
-      {"--backend grid", "--backend: only for fixed mode"},
-      {"--spheres 4", "--spheres: only for fixed mode"},
+      {"--mode sampled --backend grid", "--backend: only for the explicit design"},
+      {"--mode sampled --spheres 4", "--spheres: only for the explicit design"},
       {"--preset fig6 --drops 100", "--drops: not used by a bounce run"},
       {"--preset fig6 --mode fixed", "--mode: not used by a bounce run"},
       {"--preset fig6 --alpha 0.05", "--alpha: not used by a bounce run"},
@@ -414,7 +442,7 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {L + " --spheres 3", "--spheres: not used by a run with unequal asperity radii"},
       {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
       {M + " --radius 1e-3", "--radius: a mesh body's size"},
-      {M + " --mode fresh", "--mode: 'fresh'"},
+      {M + " --mode sampled", "--mode: 'sampled'"},
       {M + " --backend grid", "--backend: not used by a mesh body"},
   };
   for (const auto& c : cases) {
@@ -500,7 +528,7 @@ namespace {
 // a `skipped` count, the table and a warning on stderr. Exit status stays 0: nothing was rejected.
 // Here: at 1e-12 m/s some drops do not impact, so the Sec. IV laws do not apply to the sample.
 TEST(CliReport, ASkippedDecisiveLawIsVisible) {
-  for (const std::string mode : {"", " --mode fixed --spheres 4"}) {
+  for (const std::string mode : {"", " --mode sampled"}) {
     const fs::path out = fresh_dir("skipped");
     const std::string cmd = std::string(VALIDATE_GEOMETRY) + " -q --no-plots --speed 1e-12 --drops 100 --seed 2" + mode +
                             " --out " + out.string();

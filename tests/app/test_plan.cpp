@@ -19,7 +19,7 @@ Scene small(const std::string& name) {
   Scene s = preset(name);
   s.ensemble.sphere.asperities = 2000;
   s.ensemble.drops = 4000;
-  if (s.ensemble.mode == Mode::fixed) s.ensemble.spheres = 4;
+  if (s.ensemble.mode == Mode::explicit_spheres && !s.spheres_auto) s.ensemble.spheres = 4;
   s.plots = false;
   return s;
 }
@@ -47,19 +47,38 @@ TEST(Plan, EveryStageIsListedWithAReason) {
       names.push_back(s.name);
       EXPECT_FALSE(s.reason.empty()) << name << " " << s.name;
     }
-    EXPECT_EQ(names, (std::vector<std::string>{"generate", "index", "query", "impact", "analysis", "plots"})) << name;
+    EXPECT_EQ(names, (std::vector<std::string>{"generate", "index", "query", "cross_check", "impact", "analysis", "plots"}))
+        << name;
   }
 }
 
-TEST(Plan, FreshModeBuildsNoSphereAndNoIndex) {
-  const Plan p = make_plan(preset("fig3"));
+TEST(Plan, SampledModeBuildsNoSphereAndNoIndex) {
+  Scene s = preset("fig3");
+  s.ensemble.mode = Mode::sampled;
+  const Plan p = make_plan(s);
   EXPECT_FALSE(p.runs("generate"));
   EXPECT_FALSE(p.runs("index"));
+  EXPECT_FALSE(p.runs("cross_check"));
   EXPECT_TRUE(p.runs("query"));
-  const auto r = run_scene(small("fig3"));
+  Scene t = small("fig3");
+  t.ensemble.mode = Mode::sampled;
+  const auto r = run_scene(t);
   EXPECT_FALSE(stage(r, "generate").run);
   EXPECT_EQ(stage(r, "generate").seconds, 0.0);
   EXPECT_EQ(stage(r, "index").seconds, 0.0);
+}
+
+TEST(Plan, ExplicitDefaultBuildsSpheresIndexesAndCrossChecks) {
+  const Plan p = make_plan(preset("fig3"));
+  EXPECT_TRUE(p.runs("generate"));
+  EXPECT_TRUE(p.runs("index"));
+  EXPECT_TRUE(p.runs("cross_check"));
+  EXPECT_EQ(p.scene.ensemble.spheres, auto_spheres(100000, 1000000));
+  EXPECT_EQ(p.scene.ensemble.backend, Backend::grid);
+  const auto r = run_scene(small("fig3"));
+  EXPECT_TRUE(stage(r, "cross_check").run);
+  EXPECT_GE(r.cross_check.queries, 100u);
+  EXPECT_EQ(r.cross_check.agreed, r.cross_check.queries);
 }
 
 TEST(Plan, ContactOnlySceneRunsNoImpactStage) {

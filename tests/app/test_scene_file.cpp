@@ -22,11 +22,12 @@ Scene reference_preset(const std::string& name) {
   s.ensemble.drops = 1000000;
   s.ensemble.seed = 1;
   s.name = name;
+  // Since issue 13 fig3, fig4, fig5 run explicit spheres (K from the error budget: spheres = "auto").
+  s.ensemble.mode = Mode::explicit_spheres;
   if (name == "fig3") {
-    s.ensemble.mode = Mode::fresh;
   } else if (name == "fig3-fixed") {
-    s.ensemble.mode = Mode::fixed;
     s.ensemble.spheres = 100;
+    s.spheres_auto = false;
     s.ensemble.backend = Backend::grid;
     s.backend_auto = false;  // the file names its backend
   } else if (name == "fig4") {
@@ -41,6 +42,7 @@ Scene reference_preset(const std::string& name) {
   } else if (name == "fig6") {
     s.ensemble.sphere = SphereParams{1000000, 3e-3, 5e-7};
     s.bounce.enabled = true;  // BounceExperiment's defaults are the paper's Sec. V
+    s.spheres_auto = false;   // every sequence bounces its own sphere
   } else {
     ADD_FAILURE() << "no reference for preset " << name;
   }
@@ -131,8 +133,10 @@ TEST(SceneFile, EveryPresetFileEqualsThePresetAsDefinedInCode) {
 TEST(SceneFile, RoundTripsThroughToToml) {
   std::vector<Scene> scenes;
   for (const auto& name : preset_names()) scenes.push_back(preset(name));
-  scenes.push_back(parse_scene(kGood));
-  Scene odd = parse_scene(kGood);
+  // (kGood names the earlier mode "fixed": its note is about the file, to_toml writes "explicit".)
+  const std::string good = replace(kGood, "mode = \"fixed\"", "mode = \"explicit\"");
+  scenes.push_back(parse_scene(good));
+  Scene odd = parse_scene(good);
   odd.name = "quote \" backslash \\ tab \t";
   odd.ensemble.seed = 18446744073709551615ull;  // beyond TOML's int64: written as a string
   odd.ensemble.sphere.radius = 0.1 + 0.2;       // needs all 17 digits
@@ -147,9 +151,15 @@ TEST(SceneFile, RoundTripsThroughToToml) {
   scenes.push_back(contact_only);
   // Unused settings are not written: they read back as defaults.
   Scene fresh_with_spheres = preset("fig3");
-  fresh_with_spheres.ensemble.spheres = 100;  // e.g. fig3-fixed --mode fresh
+  fresh_with_spheres.ensemble.mode = Mode::sampled;
+  fresh_with_spheres.ensemble.spheres = 100;  // e.g. fig3-fixed --mode sampled
   EXPECT_EQ(parse_scene(to_toml(fresh_with_spheres)).ensemble.spheres, 1u);
+  Scene fixed_k = preset("fig3");
+  fixed_k.ensemble.spheres = 40;
+  fixed_k.spheres_auto = false;
+  scenes.push_back(fixed_k);
   Scene fresh_with_backend = preset("fig3");
+  fresh_with_backend.ensemble.mode = Mode::sampled;
   fresh_with_backend.ensemble.backend = Backend::grid;
   fresh_with_backend.backend_auto = false;
   EXPECT_TRUE(parse_scene(to_toml(fresh_with_backend)).backend_auto);
@@ -227,11 +237,18 @@ TEST(SceneFile, NanInfAndOutOfRangeValuesAreErrorsNamingKeyAndValue) {
   expect_error("name = \"x\"\n", "format");
   expect_error(replace(kGood, "mode = \"fixed\"", "mode = \"frozen\""), "ensemble.mode", "frozen");
   expect_error(replace(kGood, "backend = \"auto\"", "backend = \"octree\""), "ensemble.backend", "octree");
-  // A backend in fresh mode would be ignored: refused, naming the key and the value.
-  const std::string fresh = replace(replace(kGood, "mode = \"fixed\"", "mode = \"fresh\""), "spheres = 10", "spheres = 1");
+  // A backend for sampled drops would be ignored: refused, naming the key and the value.
+  const std::string fresh = replace(replace(kGood, "mode = \"fixed\"", "mode = \"sampled\""), "spheres = 10", "spheres = 1");
   EXPECT_NO_THROW(parse_scene(fresh));
   expect_error(replace(fresh, "backend = \"auto\"", "backend = \"grid\""), "ensemble.backend", "grid");
-  expect_error(replace(kGood, "mode = \"fixed\"", "mode = \"fresh\""), "ensemble.spheres", "fresh");
+  expect_error(replace(kGood, "mode = \"fixed\"", "mode = \"sampled\""), "ensemble.spheres", "sampled");
+  // The earlier names still read: fixed and fresh run as explicit, and say so.
+  const Scene legacy = parse_scene(replace(kGood, "mode = \"fixed\"", "mode = \"fresh\""));
+  EXPECT_EQ(legacy.ensemble.mode, Mode::explicit_spheres);
+  EXPECT_EQ(legacy.legacy_mode, "fresh");
+  EXPECT_EQ(parse_scene(kGood).ensemble.mode, Mode::explicit_spheres);
+  EXPECT_TRUE(parse_scene(replace(kGood, "spheres = 10", "spheres = \"auto\"")).spheres_auto);
+  expect_error(replace(kGood, "spheres = 10", "spheres = \"many\""), "ensemble.spheres", "many");
   expect_error(replace(kGood, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"contact\""),
                "outputs.restitution", "impact");
   expect_error(replace(replace(kGood, "contact = true", "contact = false"), "restitution = true", "restitution = false"),
@@ -345,7 +362,7 @@ TEST(SceneFileBodies, ExampleScenesParseIntoTheExpectedFields) {
   EXPECT_EQ(lv.radii->screen_directions, 100000u);
   EXPECT_EQ(lv.ensemble.sphere.asperities, 100000u);
   EXPECT_EQ(lv.ensemble.sphere.radius, 3e-3);
-  EXPECT_EQ(lv.ensemble.mode, Mode::fresh);
+  EXPECT_EQ(lv.ensemble.mode, Mode::sampled);
   EXPECT_EQ(lv.ensemble.drops, 100000u);
   EXPECT_FALSE(lv.ensemble.impact.enabled);
 
@@ -362,7 +379,7 @@ TEST(SceneFileBodies, ExampleScenesParseIntoTheExpectedFields) {
   EXPECT_FALSE(parse_scene(kMesh).mesh->export_points);
   EXPECT_EQ(el.ensemble.sphere.asperities, 100000u);
   EXPECT_EQ(el.ensemble.sphere.asperity_radius, 6.5e-7);
-  EXPECT_EQ(el.ensemble.mode, Mode::fixed);
+  EXPECT_EQ(el.ensemble.mode, Mode::explicit_spheres);
   EXPECT_EQ(el.ensemble.spheres, 10u);
   EXPECT_EQ(el.ensemble.drops, 100000u);
   EXPECT_TRUE(el.ensemble.impact.enabled);
@@ -436,12 +453,13 @@ TEST(SceneFileBodies, BadKeysInTheNewSectionsNameTheKeyAndValue) {
                "outputs.export_style", "dots");
   expect_error(replace(kMesh, "export_ply = \"m.ply\"", "export_style = \"points\""), "outputs.export_style", "export_ply");
   // Combinations the runs cannot honour are refused, naming the key.
-  expect_error(replace(kMesh, "mode = \"fixed\"\nspheres = 2", "mode = \"fresh\""), "ensemble.mode", "fixed");
+  expect_error(replace(kMesh, "mode = \"fixed\"\nspheres = 2", "mode = \"sampled\""), "ensemble.mode", "explicit");
   expect_error(replace(kMesh, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"contact\""),
                "experiment.kind", "impact");
   expect_error(replace(kMesh, "count = 2000", "areal_density = 1e10"), "asperities.areal_density", "count");
   expect_error(replace(kLevels, "seed = 3", "seed = 3\nbackend = \"grid\""), "ensemble.backend", "grid");
-  expect_error(replace(kLevels, "drops = 3000", "drops = 3000\nmode = \"fixed\""), "ensemble.mode", "fixed");
+  expect_error(replace(kLevels, "drops = 3000", "drops = 3000\nmode = \"fixed\""), "ensemble.mode", "explicit");
+  expect_error(replace(kLevels, "drops = 3000", "drops = 3000\nmode = \"explicit\""), "ensemble.mode", "sampled");
   // Every kind of run writes its report through the same writer: the report name is free.
   EXPECT_EQ(parse_scene(replace(kLevels, "plots = false", "plots = false\nreport = \"x.json\""), "t").report, "x.json");
   expect_error(replace(kMesh, "plots = false", "plots = false\nrestitution = false"), "outputs.restitution");

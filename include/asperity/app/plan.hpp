@@ -12,7 +12,7 @@
 namespace asperity {
 
 struct PlanStage {
-  std::string name;    ///< "generate", "index", "query", "impact", "analysis", "plots"
+  std::string name;    ///< "generate", "index", "query", "cross_check", "impact", "analysis", "plots"
   bool run = false;
   std::string reason;  ///< why it runs, or why it is skipped
   double seconds = 0;  ///< wall time [s] once run (0 if skipped)

@@ -25,16 +25,20 @@ struct QuantityReport {
 struct TestReport {
   std::string quantity;   ///< e.g. "r_xy"
   std::string law;        ///< "eq14", "exact-sphere", "eq18"
-  std::string scope;      ///< "all" (every drop), "pooled" (fixed: all rotations), "one-per-sphere"
-  std::string statistic;  ///< "KS" or "binomial"
+  std::string scope;      ///< "all" (every drop)
+  /// "KS" (iid drops: exact Kolmogorov p), "KS-sphere-bootstrap" (explicit: binned KS of all drops,
+  /// p from a sphere-block bootstrap, laws/block_ks.hpp) or "binomial"
+  std::string statistic;
   double D = 0;           ///< KS distance (NaN for a count test)
   double p = 1;
   std::uint64_t n = 0;
   double predicted_mean = 0;  ///< mean of the quantity under the law (NaN if not applicable)
   bool iid = true;            ///< whether the p-value's iid assumption holds for these samples
   bool decisive = true;       ///< counts towards the exit status
-  /// "accept", "reject", "quenched" (fixed: expected deviation), "skipped" (the law could not be
-  /// evaluated: D, p and predicted_mean NaN, the note says why)
+  /// "accept", "reject", "undecided" (the bootstrap's smallest attainable p is not below alpha),
+  /// "not-decisive" (explicit with fewer than kMinDecisiveSpheres spheres, e.g. one sphere: its own
+  /// law, p assumes iid), "skipped" (the law could not be evaluated: D, p and predicted_mean NaN,
+  /// the note says why)
   std::string verdict;
   std::string note;
 };
@@ -46,7 +50,17 @@ struct GeometryReport {
   double core_probability = 0;        ///< exact, per drop
   double core_probability_paper = 0;  ///< the paper's R* estimate
   double gap_min = 0, gap_median = 0; ///< runner-up height gap [m]
-  double quenched_scale = 0;          ///< typical KS deviation of one sphere's own law (fixed)
+  double quenched_scale = 0;          ///< max pointwise sd of one sphere's own cdf (explicit; quenched_deviation_scale)
+  /// The ensemble design and its error budget (report.json `design`, the table's design lines).
+  struct Design {
+    std::string kind;                 ///< "explicit" (K spheres x M rotations, spatial query) or "sampled"
+    std::uint64_t spheres = 0, rotations_per_sphere = 0;
+    std::string backend;              ///< the query backend ("none" when sampled)
+    double statistical_scale = 0;     ///< typical KS distance of the pooled sample, 0.87/sqrt(K M)
+    double quenched_scale = 0;        ///< typical KS deviation of the pooled law, c/sqrt(N K) (0 sampled)
+    double model_error_scale = 0;     ///< KS distance of Eq. 14 from the exact finite-N law
+  } design;
+  CrossCheck cross_check;             ///< queries re-answered by other backends (explicit)
   std::string ensemble_note;
   std::vector<QuantityReport> quantities;
   std::vector<TestReport> tests;
@@ -63,7 +77,8 @@ struct GeometryReport {
 
   /// A decisive test rejected its law.
   bool rejected() const;
-  /// Decisive tests that could not be evaluated (verdict "skipped").
+  /// Decisive tests that could not be evaluated (verdict "skipped") or not decided at the largest
+  /// bootstrap size (verdict "undecided").
   std::size_t skipped() const;
 };
 

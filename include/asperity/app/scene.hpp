@@ -50,6 +50,12 @@ struct Scene {
   /// ensemble.backend was not chosen by the user: the planner picks a scan or an index from the
   /// work per sphere (fixed mode). Results do not depend on the choice (every backend is exact).
   bool backend_auto = true;
+  /// ensemble.spheres was not chosen (explicit design): the planner takes K from the error budget
+  /// (auto_spheres, ensemble.hpp). Scene files write it as spheres = "auto".
+  bool spheres_auto = true;
+  /// "fresh" or "fixed" when the scene named its mode by an earlier name (it runs as explicit; the
+  /// report says so, legacy_mode_note); to_toml writes the name back. Empty otherwise.
+  std::string legacy_mode;
   double alpha = 0.01;        ///< significance level of each test
   bool plots = true;          ///< write PNG figures (needs gnuplot)
   bool contact_stats = true;  ///< analyse r_xy, r_x, r_y, r_z and core contacts against their laws

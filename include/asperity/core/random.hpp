@@ -17,6 +17,7 @@ enum class Purpose : std::uint32_t {
   analysis = 4,     ///< randomisation inside statistical tests (e.g. the PIT at an atom)
   lazy_sphere = 5,  ///< counts and centres of the cells of one lazy sphere (lazy_sphere.hpp)
   bounce = 6,       ///< per-sequence draws of a bounce sequence (initial orientation, paper laws)
+  bootstrap = 7,    ///< replicates of a sphere-block bootstrap (laws/block_ks.hpp)
   test = 99,        ///< reserved for tests
 };
 

@@ -1,13 +1,18 @@
 #pragma once
-// Ensembles of drops: many rough spheres meeting the plate, each contact found from explicit
-// geometry. Two ensembles, named in every report:
-//  - fresh: a new random sphere for every drop -- the ensemble the paper's Eqs. 13/14/18
-//    describe. Costs O(1) per drop: only the asperities that can touch are generated (below).
-//  - fixed: K explicit spheres x M random rotations each. Rotations of one sphere sample that
-//    sphere's own (quenched) law, not the ensemble law: errors come from the spread between
-//    spheres.
+// Ensembles of drops: rough spheres meeting the plate. Two designs, named in every report:
+//  - explicit (the default): K explicit spheres of N asperities x M Haar-random rotations each;
+//    every contact is found by a spatial query (grid by default; brute, kdtree, cgal, fcl) on the
+//    rotated sphere. Rotations of one sphere sample that sphere's own (quenched) law, which differs
+//    from the ensemble law of Eqs. 13/14/18 by O(1/sqrt(N)); K spheres average it down, and the
+//    decisive tests (report.hpp) take the spread between spheres into account. K follows from an
+//    error budget (auto_spheres). A deterministic subsample of the queries is answered again by
+//    brute force and the kd-tree (and FCL where built and cheap): any disagreement is an error.
+//  - sampled: no geometry. The two lowest asperities of each drop are drawn from the exact
+//    finite-N law of the lowest asperity (order statistics of the polar angle, fresh_cap): the
+//    theory cross-check and speed baseline, never called geometry.
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -18,10 +23,43 @@
 
 namespace asperity {
 
-enum class Mode { fresh, fixed };
+enum class Mode { explicit_spheres, sampled };
+/// "explicit" or "sampled".
 std::string_view to_string(Mode m);
-/// "fresh" or "fixed"; throws std::invalid_argument naming the value otherwise.
+/// "explicit" or "sampled". The names of scene files before issue 13 are accepted: "fixed" (K
+/// explicit spheres x M rotations) is "explicit"; "fresh" (it drew from the exact law, no sphere)
+/// is "explicit" too -- a law is validated from geometry unless "sampled" is asked for -- and the
+/// report says so (legacy_mode_note). Throws std::invalid_argument naming the value otherwise.
 Mode parse_mode(std::string_view s);
+/// True for "fresh" and "fixed", the names of earlier versions.
+bool is_legacy_mode(std::string_view s);
+/// The sentence a report carries when a scene named a legacy mode.
+std::string legacy_mode_note(std::string_view legacy);
+
+/// KS-scale constant of the quenched deviation: one fixed sphere's orientation-averaged law of
+/// r_xy differs from the ensemble law by E sup_t |F_sphere(t) - F(t)| ~ kQuenchedKs / sqrt(N)
+/// (measured: bench/quenched_scale.cpp, bench/RESULTS.md "Quenched deviation").
+inline constexpr double kQuenchedKs = 0.25;
+/// Fewest spheres of an automatic design: the sphere-block bootstrap of the decisive tests needs
+/// enough independent blocks to estimate the spread between spheres.
+inline constexpr std::uint64_t kAutoMinSpheres = 50;
+/// Fewest spheres for a decisive test at all (fewer: every test is reported, none decides).
+inline constexpr std::uint64_t kMinDecisiveSpheres = 20;
+
+/// The error budget of an explicit design for N asperities and `drops` drops: K spheres, M = drops/K
+/// rotations each, with M <= N / (10 c^2) (c = kQuenchedKs), so that the quenched deviation of the
+/// pooled law, c/sqrt(N K), stays below 1/sqrt(10) of the statistical resolution 1/sqrt(K M), and
+/// K >= kAutoMinSpheres (or every drop its own sphere when there are fewer drops). K is the
+/// smallest such divisor of drops.
+std::uint64_t auto_spheres(std::uint64_t asperities, std::uint64_t drops);
+
+/// Expected KS distances of a design (typical sizes, for reports): the statistical resolution of
+/// the pooled sample 0.87/sqrt(K M), and the quenched deviation of the pooled law c/sqrt(N K)
+/// (0 for the sampled design, whose drops are iid).
+struct DesignScales {
+  double statistical = 0, quenched = 0;
+};
+DesignScales design_scales(Mode mode, std::uint64_t asperities, std::uint64_t spheres, std::uint64_t drops);
 
 /// A single impact per drop (paper Sec. IV): the body falls onto a horizontal plate (n = +z) with
 /// V = (0, 0, -speed) and spin omega; the impulse is solved with the full rigid-body law.
@@ -50,11 +88,11 @@ inline constexpr int kMaxThreads = 1024;
 
 struct EnsembleConfig {
   SphereParams sphere;
-  Mode mode = Mode::fresh;
-  std::uint64_t drops = 1000000;  ///< total drops (fixed: spheres x rotations)
-  std::uint64_t spheres = 1;      ///< K (fixed mode); drops must be a multiple of K
+  Mode mode = Mode::explicit_spheres;
+  std::uint64_t drops = 1000000;  ///< total drops (explicit: spheres x rotations)
+  std::uint64_t spheres = 1;      ///< K (explicit design); drops must be a multiple of K
   std::uint64_t seed = 1;
-  Backend backend = Backend::grid;  ///< fixed mode only
+  Backend backend = Backend::grid;  ///< explicit design only
   int threads = 0;                  ///< 0 = OpenMP default, at most kMaxThreads
   ImpactExperiment impact;          ///< off: contact statistics only (nothing else is computed)
 
@@ -64,10 +102,26 @@ struct EnsembleConfig {
 /// Throws std::invalid_argument naming the offending field.
 void validate(const EnsembleConfig& c);
 
+/// A deterministic subsample of an explicit run's queries answered again by other exact backends:
+/// drops j (a multiple of a stride) of spheres 0, s, 2s, ... (as few as hold the quota: one when it
+/// has enough rotations; s = K / their number), about 1 % of the drops, at least
+/// 100 and at most 10^4, and fewer when the brute scans would cost more than ~5 % of the run
+/// (queries x N <= kCrossCheckScanBudget; never fewer than 100). Backends: brute and kdtree (each
+/// skipped when it is the run's own backend), fcl when built and N <= kCrossCheckFclMax (its
+/// build is ~0.08 s at 10^5). A disagreement makes run_contact_ensemble throw std::runtime_error.
+struct CrossCheck {
+  std::uint64_t queries = 0, agreed = 0;
+  std::vector<std::string> backends;
+  double seconds = 0;
+};
+/// Brute-force work of the cross-check, queries x N: ~1.3 ns each, so ~26 ms.
+inline constexpr double kCrossCheckScanBudget = 2e7;
+inline constexpr std::uint64_t kCrossCheckFclMax = 20000;
+
 /// Per-drop results, index = drop number (independent of thread count and schedule).
 struct ContactSamples {
-  Mode mode = Mode::fresh;
-  std::size_t batches = 0;          ///< fixed: K spheres; fresh: number of drops (iid)
+  Mode mode = Mode::explicit_spheres;
+  std::size_t batches = 0;          ///< explicit: K spheres; sampled: number of drops (iid)
   std::vector<double> r_x, r_y, r_z, r_xy;  ///< lowest asperity's contact vector, world frame [m]
   std::vector<double> gap;          ///< runner-up height gap [m] (+inf if N == 1)
   std::vector<std::uint8_t> core;   ///< 1 if the central sphere touches first
@@ -81,13 +135,17 @@ struct ContactSamples {
   std::uint64_t no_impacts = 0;       ///< drops whose contact point does not approach the plate (v_n >= 0):
                                       ///< counted here, absent from eps/omega_x_after/eps_n
   double seconds_generate = 0, seconds_index = 0, seconds_query = 0, seconds_impact = 0;
-  std::size_t index_bytes = 0;      ///< memory of one spatial index (fixed mode)
+  std::size_t index_bytes = 0;      ///< memory of one spatial index (explicit design)
+  CrossCheck cross_check;           ///< explicit design: queries answered again by other backends
 };
 
 /// Called now and then from the calling thread with (drops done, drops total).
 using Progress = std::function<void(std::uint64_t, std::uint64_t)>;
 
 ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& progress = {});
+
+/// The backends that re-answer the cross-checked queries of a run with backend `main` (CrossCheck).
+std::vector<Backend> cross_check_backends(Backend main, std::uint64_t asperities);
 
 /// The lowest two asperities of a fresh random sphere, exactly, in O(1): with
 /// X_i = (1 - cos theta_i)/2 iid uniform on (0,1), the sorted X are generated in order by the

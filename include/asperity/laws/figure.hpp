@@ -20,7 +20,9 @@ struct Curve {
 Curve sampled_curve(const std::function<double(double)>& f, std::string label, double lo, double hi, int segments = 300);
 
 struct HistogramFigure {
-  std::string title;        ///< e.g. "r_{xy}, N = 10^5, fresh, 10^6 drops"
+  std::string title;        ///< e.g. "r_{xy}, N = 10^5, explicit geometry: 50 spheres x 20000 rotations"
+  /// Legend of the measured points, followed by " (n = <count>)": which ensemble they come from.
+  std::string data_label = "explicit geometry";
   std::string xlabel;       ///< with units, e.g. "r_x [µm]"
   std::string ylabel = "probability density";
   double x_scale = 1.0;     ///< multiply x values (histogram and curves) for display, e.g. 1e6 for µm

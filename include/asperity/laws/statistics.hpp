@@ -130,6 +130,9 @@ Chi2Result chi2_test(const Histogram& h, const Cdf& cdf, double min_expected = 5
 /// h = (n-1) prob, x[floor h] + (h - floor h)(x[floor h + 1] - x[floor h]) (0-based).
 /// Throws for empty or unsorted data or prob outside [0,1].
 double quantile_sorted(std::span<const double> sorted, double prob);
+/// The same type-7 quantiles of unsorted data, by selection (nth_element) instead of a sort:
+/// O(n) per distinct rank. Reorders `x`. Same throws as quantile_sorted (for empty x, NaN x, prob).
+std::vector<double> quantiles_unsorted(std::vector<double>& x, std::span<const double> probs);
 
 struct Summary {
   std::size_t n = 0;

@@ -142,11 +142,13 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   app.add_option("--asperities,-N", asperities, "number of asperities N (>= 1)");
   app.add_option("--radius", radius, "central sphere radius R [m]");
   app.add_option("--asperity-radius", asperity_radius, "asperity radius a [m], 0 < a < R");
-  app.add_option("--drops", drops, "number of drops (fixed: spheres x rotations)");
-  app.add_option("--mode", mode, "fresh (a new sphere per drop) or fixed (K spheres x M rotations)");
-  app.add_option("--spheres,-K", spheres, "number of explicit spheres K (fixed mode)");
+  app.add_option("--drops", drops, "number of drops (explicit: spheres x rotations)");
+  app.add_option("--mode", mode,
+                 "explicit (default: K explicit spheres x M rotations, contacts by spatial query) or sampled (drawn "
+                 "from the exact finite-N law of the lowest asperity; no geometry); fixed and fresh are read as explicit");
+  app.add_option("--spheres,-K", spheres, "number of explicit spheres K (explicit design; default: from the error budget)");
   app.add_option("--seed", seed, "random seed (results are identical for any thread count)");
-  app.add_option("--backend", backend, "contact query: brute, kdtree, cgal, fcl, grid (fixed mode)");
+  app.add_option("--backend", backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
   app.add_option("--threads", threads, "OpenMP threads (0 = all)");
   app.add_option("--alpha", alpha, "significance level of each test, in (0,1)");
   app.add_option("--out", out, "output directory for report.json and figures");
@@ -222,22 +224,26 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     }
     if (given("--mode")) {
       e.mode = parse_mode(mode);
-      // A backend the file chose for its explicit spheres does not apply to fresh drops.
-      if (e.mode == Mode::fresh && !given("--backend")) scene.backend_auto = true;
+      // Earlier names: "fixed" = explicit; "fresh" = explicit (with a note), for unequal radii their sampler.
+      scene.legacy_mode = is_legacy_mode(mode) && !radii && !mesh && !bounce ? mode : std::string();
+      if (radii && mode == "fresh") e.mode = Mode::sampled;
+      // A backend the file chose for its explicit spheres does not apply to sampled drops.
+      if (e.mode == Mode::sampled && !given("--backend")) scene.backend_auto = true;
       if (bounce) refuse("--mode", "not used by " + kind + ": every sequence bounces its own sphere");
-      if (mesh && e.mode != Mode::fixed)
-        refuse("--mode", "'" + mode + "': " + kind + " runs explicit bodies x rotations: only \"fixed\"");
-      if (radii && e.mode != Mode::fresh)
-        refuse("--mode", "'" + mode + "': " + kind + " draws fresh spheres and screens [screening] bodies: only "
-                         "\"fresh\" (or give --asperity-radius for the paper's equal radii)");
+      if (mesh && e.mode != Mode::explicit_spheres)
+        refuse("--mode", "'" + mode + "': " + kind + " runs explicit bodies x rotations: only \"explicit\"");
+      if (radii && e.mode != Mode::sampled)
+        refuse("--mode", "'" + mode + "': " + kind + " draws from its exact sampler and screens [screening] bodies: only "
+                         "\"sampled\" (or give --asperity-radius for the paper's equal radii)");
     }
     if (given("--spheres")) {
       e.spheres = parse_count("--spheres", spheres, 1, kMaxDrops);
+      scene.spheres_auto = false;
       if ((bounce && !mesh) || radii)
         refuse("--spheres", "not used by " + kind + (radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
-      if (!mesh && e.mode != Mode::fixed)
-        refuse("--spheres", "only for fixed mode (explicit spheres x rotations); fresh mode draws a new sphere per drop: "
-                            "add --mode fixed");
+      if (!mesh && e.mode != Mode::explicit_spheres)
+        refuse("--spheres", "only for the explicit design (explicit spheres x rotations); sampled drops build no sphere: "
+                            "add --mode explicit");
     }
     if (given("--seed")) e.seed = parse_count("--seed", seed, 0, ~std::uint64_t{0});
     if (given("--speed")) {
@@ -266,9 +272,9 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
       scene.backend_auto = false;
       if (bounce || mesh || radii)
         refuse("--backend", "not used by " + kind + (bounce ? "" : ", which queries the exact support tree"));
-      if (e.mode != Mode::fixed)
-        refuse("--backend", "only for fixed mode (explicit spheres); fresh mode queries no index (the lowest asperities "
-                            "are drawn exactly): add --mode fixed");
+      if (e.mode != Mode::explicit_spheres)
+        refuse("--backend", "only for the explicit design (explicit spheres); sampled drops query no index (the lowest "
+                            "asperities are drawn from the exact law): add --mode explicit");
     }
     if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
       throw BadInput("--variant/--sequences need a bounce run: --preset fig6");

@@ -2,6 +2,7 @@
 // the paper's laws and the exact finite-N laws, print a table, write report.json and figures.
 // Exit status: 0 no law rejected (skipped laws: a warning), 1 a law rejected, 2 bad input or an
 // output that cannot be written.
+#include <malloc.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -36,6 +37,11 @@ int main(int argc, char** argv) {
   // First, before any thread exists: SIGINT/SIGTERM/SIGHUP/SIGPIPE remove this run's temporaries
   // (its staging directory, gnuplot's files, the directories it created) and exit 128 + signal.
   install_interrupt_cleanup("validate-geometry");
+  // Explicit runs build and drop K spheres and indexes of a few MB each: keep freed memory in the
+  // heap instead of returning it to the kernel, so that the next sphere does not page-fault its
+  // memory in again (halved the index stage of fig3 on the loaded 2-core machine; bench/RESULTS.md).
+  mallopt(M_MMAP_THRESHOLD, 256 << 20);
+  mallopt(M_TRIM_THRESHOLD, 512 << 20);
   Scene scene;
   bool quiet = false;
   // Everything that can be checked is checked before the output directory is touched.

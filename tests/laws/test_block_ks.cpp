@@ -1,0 +1,148 @@
+// The decisive test of explicit ensembles (laws/block_ks.hpp): binned KS of all drops with a
+// sphere-block bootstrap. Each statistical property is checked against an input it must reject.
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "asperity/core/random.hpp"
+#include "asperity/laws/block_ks.hpp"
+
+using namespace asperity;
+
+namespace {
+
+const Cdf kUniform = [](double t) { return std::clamp(t, 0.0, 1.0); };
+
+// n iid uniforms; or `blocks` blocks, block b uniform on [o_b, o_b + 1 - a] with o_b uniform on
+// [0, a] (a = `shared`): each block has its own law (like one sphere's quenched law), and the pooled
+// law is the trapezoid mixture_cdf below.
+std::vector<double> sample(std::uint64_t seed, std::size_t n, std::size_t blocks = 0, double shared = 0) {
+  std::vector<double> x(n);
+  const std::size_t m = blocks ? n / blocks : 1;
+  double offset = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (blocks && i % m == 0) offset = shared * Stream(seed, Purpose::test, 1u << 30, i / m).uniform0();
+    Stream s(seed, Purpose::test, i);
+    x[i] = offset + (1.0 - shared) * s.uniform0();
+  }
+  return x;
+}
+
+// cdf of U[0, a] + U[0, 1 - a] (a < 1/2).
+Cdf mixture_cdf(double a) {
+  const double b = 1.0 - a;
+  return [a, b](double t) {
+    if (t <= 0) return 0.0;
+    if (t >= 1) return 1.0;
+    if (t <= a) return t * t / (2 * a * b);
+    if (t <= b) return (t - a / 2) / b;
+    return 1.0 - (1 - t) * (1 - t) / (2 * a * b);
+  };
+}
+
+double rejection_rate(std::size_t seeds, std::size_t n, std::size_t blocks, double shared, double alpha, const Cdf& cdf,
+                      std::size_t grid = 128) {
+  std::size_t rej = 0;
+  std::vector<Cdf> laws{cdf};
+  for (std::size_t s = 1; s <= seeds; ++s) {
+    const auto x = sample(s, n, blocks, shared);
+    const auto b = bin_by_block(x, blocks ? blocks : n, grid, 256);
+    rej += block_ks_tests(b, laws, alpha, s, 0, 199, 999)[0].verdict == "reject";
+  }
+  return double(rej) / double(seeds);
+}
+
+TEST(BlockKs, BinnedDistanceIsTheKsDistanceAtTheGridPoints) {
+  const auto x = sample(1, 20000);
+  const auto b = bin_by_block(x, 100, 1024);
+  // At every grid point e the pooled ecdf is the fraction <= e, counted directly (also with ties:
+  // samples equal to grid points, on a coarse lattice).
+  for (const auto& data : {x, [&] {
+         auto y = x;
+         for (auto& v : y) v = std::round(v * 50) / 50;
+         return y;
+       }()}) {
+    const auto bb = bin_by_block(data, 100, 1024);
+    std::vector<double> s = data;
+    std::sort(s.begin(), s.end());
+    for (std::size_t j = 0; j < bb.edges.size(); ++j) {
+      const auto below = std::upper_bound(s.begin(), s.end(), bb.edges[j]) - s.begin();
+      ASSERT_EQ(bb.pooled[j], double(below) / double(s.size())) << j;
+    }
+  }
+  std::vector<double> s = x;
+  std::sort(s.begin(), s.end());
+  const double full = ks_one_sample(s, kUniform).D;
+  const double binned = binned_ks_distance(b, kUniform);
+  EXPECT_LE(binned, full + 1e-12);
+  EXPECT_GT(binned, full - 2.0 / 1024);  // grid points at quantiles: at most ~1/grid of mass between two
+}
+
+TEST(BlockKs, IidCalibrationAndPower) {
+  // Blocks of one sample each (iid): the true law is rejected at ~alpha, a 5 % stretch is not missed.
+  const std::size_t seeds = 200;
+  const double alpha = 0.05;
+  const double rate = rejection_rate(seeds, 1000, 0, 0, alpha, kUniform);
+  const double se = std::sqrt(alpha * (1 - alpha) / double(seeds));
+  std::printf("iid: rejection rate of the true law %.3f +- %.3f (alpha %.2f, %zu seeds)\n", rate, se, alpha, seeds);
+  EXPECT_NEAR(rate, alpha, 3.5 * se);
+  const Cdf stretched = [](double t) { return std::clamp(t / 1.15, 0.0, 1.0); };
+  EXPECT_GT(rejection_rate(20, 1000, 0, 0, alpha, stretched), 0.8);
+}
+
+TEST(BlockKs, CorrelatedBlocksNeedTheBlockBootstrap) {
+  // 50 blocks, each with its own law: the pooled ecdf scatters far more than iid samples would.
+  // The block bootstrap keeps the level; the iid Kolmogorov p-value does not.
+  const std::size_t seeds = 200, n = 5000, blocks = 50;
+  const double alpha = 0.05, shared = 0.3;
+  const double rate = rejection_rate(seeds, n, blocks, shared, alpha, mixture_cdf(shared));
+  const double se = std::sqrt(alpha * (1 - alpha) / double(seeds));
+  std::printf("blocks: rejection rate of the true law %.3f +- %.3f (alpha %.2f, %zu seeds, %zu blocks)\n", rate, se,
+              alpha, seeds, blocks);
+  EXPECT_NEAR(rate, alpha, 3.5 * se);
+  std::size_t iid_rej = 0;
+  for (std::size_t s = 1; s <= 50; ++s) {
+    auto x = sample(s, n, blocks, shared);
+    std::sort(x.begin(), x.end());
+    iid_rej += ks_one_sample(x, mixture_cdf(shared)).p < alpha;
+  }
+  EXPECT_GT(double(iid_rej) / 50.0, 0.3) << "the iid p-value must be wrong here, or this test shows nothing";
+}
+
+TEST(BlockKs, UndecidedWhenTheSmallestPIsNotBelowAlpha) {
+  const auto x = sample(3, 2000);
+  const auto b = bin_by_block(x, 2000, 256);
+  const Cdf wrong = [](double t) { return std::clamp(t * t, 0.0, 1.0); };
+  std::vector<Cdf> laws{wrong, kUniform};
+  const auto r = block_ks_tests(b, laws, 1e-4, 1, 0, 199, 999);  // floor 1/1000 > alpha
+  EXPECT_EQ(r[0].verdict, "undecided");
+  EXPECT_EQ(r[1].verdict, "undecided");
+  const auto r2 = block_ks_tests(b, laws, 0.01, 1, 0);
+  EXPECT_EQ(r2[0].verdict, "reject");
+  EXPECT_EQ(r2[1].verdict, "accept");
+}
+
+TEST(BlockKs, ReplicatesIdenticalForOneAndTwoThreads) {
+  const auto x = sample(4, 6000, 60, 0.2);
+  const auto b = bin_by_block(x, 60, 512);
+  std::vector<double> one, two;
+  omp_set_num_threads(1);
+  block_bootstrap_ks(b, 9, 2, 0, 300, one);
+  omp_set_num_threads(2);
+  block_bootstrap_ks(b, 9, 2, 0, 300, two);
+  EXPECT_EQ(one, two);
+  omp_set_num_threads(omp_get_num_procs());
+}
+
+TEST(BlockKs, RefusesBadInput) {
+  std::vector<double> x{0.1, 0.2, 0.3};
+  EXPECT_THROW(bin_by_block(x, 2), std::invalid_argument);
+  x[1] = std::nan("");
+  EXPECT_THROW(bin_by_block(x, 3), std::invalid_argument);
+}
+
+}  // namespace
