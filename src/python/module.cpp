@@ -658,7 +658,7 @@ without an impact (v_n >= 0) are NaN with impact False.)doc");
       R"doc(A restitution table for DEM codes (app/cor_table.hpp; README "Restitution tables").
 
 The sphere, material, spin and seed come from `scene` (a sphere impact scene); speeds [m/s]
-default to 9 points from u/10 to 10 u around its impact speed u; drops (fresh spheres per speed)
+default to 9 points from u/10 to 10 u around its impact speed u; drops per speed (sampled from the exact law of the lowest asperity)
 default to 1e5. Returns the JSON header as a dict plus arrays speeds, p, quantiles (speeds x p);
 with path, writes path (CSV) and the .json next to it (files lists them).)doc");
 }

@@ -23,9 +23,9 @@ def preset_dict(name):
 def small_scene(tmp_path):
     """Writes a small Fig. 4 scene file (impacts, N = 1000, no plots); returns its path.
 
-    mode "fresh" is fig4's ensemble mode, "fixed" fig3-fixed's (K explicit spheres x rotations)."""
+    mode "sampled" draws from the exact law (no geometry), "explicit" builds K explicit spheres x rotations."""
 
-    def make(mode="fresh", drops=20000, spheres=1, seed=7, name="scene.toml", count=1000, backend="auto"):
+    def make(mode="sampled", drops=20000, spheres=1, seed=7, name="scene.toml", count=1000, backend="auto"):
         s = preset_dict("fig4")
         s["name"] = "small-impact"
         s["asperities"]["count"] = count

@@ -37,7 +37,7 @@ def assert_same(cli, py, path="report"):
         assert cli == py, f"{path}: CLI {cli!r} != module {py!r}"
 
 
-@pytest.mark.parametrize("mode,spheres", [("fresh", 1), ("fixed", 4)])
+@pytest.mark.parametrize("mode,spheres", [("sampled", 1), ("explicit", 4)])
 def test_run_equals_cli_report(small_scene, mode, spheres):
     scene = small_scene(mode=mode, spheres=spheres, drops=20000)
     cli = cli_report(scene)
