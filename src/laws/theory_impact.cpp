@@ -138,7 +138,7 @@ Setup setup(const ImpactScene& s) {
   const auto en = viscoelastic_pade14(s.beta);
   p.lambda = areal_density(s.asperities, x.R);
   p.sigma = 1.0 / std::sqrt(2.0 * pi * p.lambda);
-  p.inertia = 0.4 * x.R * x.R;
+  p.inertia = 0.4 * (s.literal_eq23 ? x.a * x.a : x.R * x.R);
   const double rz = x.R + x.a;
   p.c2 = p.inertia + rz * rz;
   p.eps_n = (*en)(x.u);

@@ -504,6 +504,23 @@ TEST(TheoryImpactMC, WrongLawsAreRejected) {
   EXPECT_LT(ks("fig5 eps", e.eps, eq28_corrected(fig5(), 1.05)).p, kReject);
 }
 
+TEST(TheoryImpactMC, LiteralEq23IsRejectedByExplicitGeometry) {
+  // Eq. 23 prints J = (2/5) M rho^2, rho the asperity radius. The rough sphere's J is the central
+  // sphere's (2/5) M R^2: the asperities add a mass fraction N (a/R)^3 ~ 1e-6 at Fig. 4. Read
+  // literally, I_g = (2/5) a^2 ~ 2e-13 m^2 drops out of c^2 = I_g + (R+a)^2, so alpha and sigma_c
+  // grow by c^2/(R+a)^2 = 1.4: the mean deficit 2 alpha sigma^2 becomes 7.8e-5 (not 5.56e-5) and
+  // Eq. 33's sigma_c 3.77 rad/s (not 2.69). Explicit contacts with the full solve reject both.
+  ImpactScene lit = fig4();
+  lit.literal_eq23 = true;
+  const auto p = impact_law_parameters(fig4()), q = impact_law_parameters(lit);
+  EXPECT_NEAR(q.alpha / p.alpha, 1.4, 1e-3);
+  EXPECT_NEAR(q.sigma_c / p.sigma_c, 1.4, 1e-3);
+  EXPECT_LT(1e5 * std::pow(lit.asperity_radius / lit.radius, 3), 2e-5);
+  const Drops& d = drops("fig4", fig4());
+  EXPECT_LT(ks("fig4 eps", d.eps, eq28_corrected(lit)).p, kReject);
+  EXPECT_LT(ks("fig4 Omega'_x", d.wx, eq33_corrected(lit)).p, kReject);
+}
+
 TEST(TheoryImpactMC, MillionDropsOnRequest) {
   // The resolution the laws are built for (KS critical distance 1.95e-3 at p = 1e-3): 1e6 drops
   // per scene, ~15 s in all. Run with ASPERITY_LONG_TESTS=1.

@@ -44,6 +44,10 @@ struct ImpactScene {
   double omega_y = 0.0;               ///< [rad/s]
   double beta = 0.0467;               ///< Pade [1/4] material constant [(s/m)^(1/5)]
   bool core_contacts = false;         ///< corrected laws only: include bare-sphere contacts (atom of mass p0)
+  /// Eq. 23 read literally: J = (2/5) M rho^2 with rho the ASPERITY radius, I_g = (2/5) a^2 (the
+  /// default, and the code's physics, is the central sphere's J = (2/5) M R^2; the asperities add
+  /// ~N (a/R)^3 to it). For the README's table and a test that explicit geometry rejects it.
+  bool literal_eq23 = false;
 };
 
 /// Throws std::invalid_argument naming the field: N >= 1, R > 0, 0 <= a < R, u > 0, beta > 0,
