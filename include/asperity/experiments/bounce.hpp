@@ -193,7 +193,7 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
 std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& sphere, const BounceExperiment& b,
                                                        std::uint64_t seed, int threads = 0, std::ostream* log = nullptr);
 
-/// Why speed windows, not impact numbers, give the unbiased p(eps | u).
+/// Which grouping answers which question, and when window selection by the past biases it.
 std::string bounce_grouping_note();
 
 
