@@ -13,7 +13,9 @@
 #include <string>
 
 #include "asperity/experiments/bounce.hpp"
+#include "asperity/core/random.hpp"
 #include "asperity/core/restitution.hpp"
+#include "asperity/laws/laplace.hpp"
 #include "asperity/laws/statistics.hpp"
 #include "asperity/laws/theory_impact.hpp"
 
@@ -238,6 +240,42 @@ TEST(Bounce, SecVPaperProcedureHasTheMarginalButKeepsTheSpinSign) {
   const auto r = residuals_at(h, 10, b.beta);
   EXPECT_LT(ks_one_sample(r, [&](double t) { return laws[9].cdf(t); }).p, 1e-6);
   EXPECT_LT(std::abs(rh.lag1_correlation.value), 4 * rh.lag1_correlation.se);
+}
+
+TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
+  // A Gaussian sample of 4000 is not Laplace (KS D ~ 0.03, far beyond the bootstrap's replicates).
+  // With B = 19 the smallest p is 1/20 > alpha = 0.01: the group must be "cannot decide at this B",
+  // never "accept"; with B = 199 (floor 0.005) the same data are rejected. A Laplace sample of the
+  // same size is accepted at B = 19.
+  auto make = [](bool laplace) {
+    BounceSamples s;
+    s.variant = BounceVariant::paper_corrected28;
+    s.sequences = 4000;
+    const AsymmetricLaplace L{0.95, std::log(2e5), std::log(3e5)};
+    for (std::uint32_t i = 0; i < 4000; ++i) {
+      Stream st(3, Purpose::test, i);
+      const double g = std::sqrt(-2 * std::log(st.uniform())) * std::cos(2 * std::numbers::pi * st.uniform0());
+      s.sequence.push_back(i), s.number.push_back(1), s.speed.push_back(1.0);
+      s.eps.push_back(laplace ? L.sample(st) : 0.95 + 5e-6 * g);
+      s.eps_time.push_back(std::nan("")), s.spin.push_back(0), s.omega_x_after.push_back(0), s.core.push_back(0);
+    }
+    return s;
+  };
+  auto b = small(4000);
+  b.windows.clear(), b.impact_numbers = {1}, b.alpha = 0.01;
+  b.bootstrap = 19;
+  const auto gauss = make(false);
+  auto r = analyse_bounces(gauss, b, 7);
+  ASSERT_EQ(r.groups.size(), 1u);
+  EXPECT_EQ(r.groups[0].gof.bootstrap, 19u);
+  EXPECT_NEAR(r.groups[0].gof.p, 0.05, 1e-12);
+  EXPECT_EQ(r.groups[0].gof_verdict, "cannot decide at this B");
+  b.bootstrap = 199;
+  r = analyse_bounces(gauss, b, 7);
+  EXPECT_EQ(r.groups[0].gof_verdict, "reject");
+  b.bootstrap = 19;
+  r = analyse_bounces(make(true), b, 7);
+  EXPECT_EQ(r.groups[0].gof_verdict, "accept") << "p = " << r.groups[0].gof.p;
 }
 
 TEST(Bounce, ValidationNamesTheField) {
