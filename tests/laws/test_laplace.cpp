@@ -51,6 +51,8 @@ TEST(Laplace, FitRecoversParametersWithinStatedErrors) {
   EXPECT_LT(std::abs(f.m.value - law.m), 4 * f.m.se);
   EXPECT_LT(std::abs(f.log_a.value - law.log_a), 4 * f.log_a.se);
   EXPECT_LT(std::abs(f.log_c.value - law.log_c), 4 * f.log_c.se);
+  // A rate 10 % off is outside the same 4 se (se(log a) ~ 0.013 here).
+  EXPECT_GT(std::abs(f.log_a.value - (law.log_a + std::log(1.1))), 4 * f.log_a.se);
   EXPECT_GT(f.log_a.se, 0.005);
   EXPECT_LT(f.log_a.se, 0.05);
   EXPECT_NEAR(f.a.se / f.a.value, f.log_a.se, 1e-15);
@@ -61,17 +63,20 @@ TEST(Laplace, ConfidenceIntervalsCover) {
   // 0.95 +- 3 binomial sd (sd = 0.011). A wrong se (e.g. half) would give ~0.68 and fail.
   const auto law = truth();
   const int reps = 400;
-  int cov_m = 0, cov_a = 0, cov_c = 0;
+  int cov_m = 0, cov_a = 0, cov_c = 0, wrong_a = 0;
   for (int r = 0; r < reps; ++r) {
     const auto f = fit_asymmetric_laplace(draw(law, 1000, 100 + r));
     cov_m += std::abs(f.m.value - law.m) < 1.96 * f.m.se;
     cov_a += std::abs(f.log_a.value - law.log_a) < 1.96 * f.log_a.se;
     cov_c += std::abs(f.log_c.value - law.log_c) < 1.96 * f.log_c.se;
+    // A se 25 % too small (the size that matters: e.g. a missing factor in the Fisher information).
+    wrong_a += std::abs(f.log_a.value - law.log_a) < 1.96 * 0.75 * f.log_a.se;
   }
   for (int c : {cov_m, cov_a, cov_c}) {
     EXPECT_GT(c / double(reps), 0.95 - 0.033) << c;
     EXPECT_LT(c / double(reps), 0.95 + 0.033) << c;
   }
+  EXPECT_LT(wrong_a / double(reps), 0.95 - 0.033) << wrong_a;  // ~0.86 expected
 }
 
 TEST(Laplace, ProfileLikelihoodIsTheMaximum) {

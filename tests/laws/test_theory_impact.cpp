@@ -502,6 +502,17 @@ TEST(TheoryImpactMC, WrongLawsAreRejected) {
   EXPECT_LT(ks("fig4 Omega'_x", d.wx, eq33_corrected(s, 1.05)).p, kReject);
   const Drops& e = drops("fig5", fig5());
   EXPECT_LT(ks("fig5 eps", e.eps, eq28_corrected(fig5(), 1.05)).p, kReject);
+  EXPECT_LT(ks("fig5 Omega'_x", e.wx, eq33_corrected(fig5(), 1.05)).p, kReject);
+  // The same 5 % next to the spin scenes' acceptances (LargeSpin, ObliqueSpin). At Omega_x = 50 the
+  // width of eps is the linear term b r_perp (alpha only scales the small alpha r^2 part: alpha x
+  // 1.05 gives D = 0.0024, p = 0.19 there), so the wrong input that matters is b: the spin 5 % off.
+  for (const auto& [key, sc] : {std::pair{std::string("spin50"), spin50()}, std::pair{std::string("oblique"), oblique()}}) {
+    const Drops& g = drops(key, sc);
+    ImpactScene wrong = sc;
+    wrong.omega_x *= 1.05, wrong.omega_y *= 1.05;
+    EXPECT_LT(ks(key + " eps", g.eps, key == "spin50" ? eq28_corrected(wrong) : eq28_corrected(sc, 1.05)).p, kReject);
+    EXPECT_LT(ks(key + " Omega'_x", g.wx, eq33_corrected(sc, 1.05)).p, kReject);
+  }
 }
 
 TEST(TheoryImpactMC, LiteralEq23IsRejectedByExplicitGeometry) {
