@@ -15,7 +15,7 @@ nlohmann::json json_of(const Estimate& e) { return {{"value", e.value}, {"se", e
 nlohmann::json json_of(const LawCheck& c) {
   return {{"quantity", c.quantity}, {"law", c.law},     {"lambda", c.lambda},           {"statistic", "KS"},
           {"D", c.ks.D},            {"p", c.ks.p},       {"n", c.ks.n},                  {"power_check", c.power_check},
-          {"decisive", c.decisive}, {"verdict", c.verdict},   {"note", c.note}};
+          {"decisive", c.decisive}, {"verdict", to_string(c.verdict)},   {"note", c.note}};
 }
 
 // tests[], plots, rejected, skipped of a report body.
@@ -36,11 +36,11 @@ void write_tests(std::ostream& os, const std::vector<LawCheck>& tests, const cha
   for (const auto& t : tests) {
     os << std::setw(qw) << t.quantity << std::setw(lw) << t.law;
     if (lambda) os << std::setw(13) << t.lambda;
-    os << std::setw(11) << t.ks.D << std::setw(11) << t.ks.p << t.verdict
+    os << std::setw(11) << t.ks.D << std::setw(11) << t.ks.p << to_string(t.verdict)
        << (t.power_check ? " (power check: must reject)" : "") << "\n";
   }
   for (const auto& t : tests)
-    if (t.verdict == "skipped")
+    if (t.verdict == Verdict::skipped)
       os << "skipped: " << t.quantity << " " << t.law << (t.decisive ? " (decisive)" : "") << ": " << t.note << "\n";
 }
 }  // namespace

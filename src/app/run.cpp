@@ -71,7 +71,7 @@ RadiiExperiment radii_experiment(const Scene& s) {
 std::vector<std::string> skipped_of(const std::vector<LawCheck>& tests) {
   std::vector<std::string> out;
   for (const auto& t : tests)
-    if (t.decisive && t.verdict == "skipped") out.push_back(t.quantity + " " + t.law + ": " + t.note);
+    if (t.decisive && t.verdict == Verdict::skipped) out.push_back(t.quantity + " " + t.law + ": " + t.note);
   return out;
 }
 

@@ -146,19 +146,64 @@ void tally(ScreeningResult& r, const std::vector<std::uint32_t>& ncomp) {
 
 }  // namespace
 
+namespace {
+
+// Competitors of asperity j on a sphere: the centres within L R whose half-space is not satisfied
+// everywhere in the cap region {|x| <= 1, u_j.x >= c} where j can win.
+std::vector<HalfSpace> cap_competitors(const RoughBody& b, const SupportQuery& q, const std::vector<Vec3>& u,
+                                       const std::vector<double>& sr, std::uint32_t j, double c, double S, double L) {
+  const Vec3& uj = u[j];
+  std::vector<HalfSpace> comp;
+  for (std::uint32_t i : q.within(b.centres[j], L * b.base_radius)) {
+    if (i == j) continue;
+    const Vec3 a = uj - u[i];
+    const double beta = sr[i] - sr[j];
+    if (c > 0) {
+      // min over the cap region of a.x, on its rim.
+      const double au = a.dot(uj);
+      const double perp = std::sqrt(std::max(0.0, a.squaredNorm() - au * au));
+      if (c * au - S * perp - beta > 1e-13) continue;  // satisfied everywhere in the region
+    }
+    comp.push_back({a, beta});
+  }
+  return comp;
+}
+
+// Witness search: over-relaxed projections onto the most violated constraint, on the sphere; true
+// if a direction where j wins is found (confirmed by the exact support query).
+bool cap_witness(const RoughBody& b, const SupportQuery& q, const std::vector<HalfSpace>& comp, std::uint32_t j,
+                 const Vec3& uj, double c) {
+  Vec3 d = uj;
+  for (int it = 0; it < 200; ++it) {
+    double worst = 0;
+    const HalfSpace* w = nullptr;
+    for (const HalfSpace& h : comp) {
+      const double v = h.n.dot(d) - h.beta;
+      if (v < worst) worst = v, w = &h;
+    }
+    if (!w) return support_value(b.centres[j], b.radii[j], d) >= q.support(d).h;
+    d += 1.5 * (-worst / w->n.squaredNorm()) * w->n;
+    d.normalize();
+    if (d.dot(uj) < c) return false;  // left the region where j can win
+  }
+  return false;
+}
+
+}  // namespace
+
 ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
   const auto t0 = std::chrono::steady_clock::now();
   const double R = b.base_radius;
   if (!(R > 0)) throw std::invalid_argument("screen_sphere: body '" + b.name + "' is not a rough sphere (base radius 0)");
   const std::size_t n = b.size();
   std::vector<Vec3> u(n);
-  std::vector<double> s(n);
+  std::vector<double> sr(n);
   double s_min = std::numeric_limits<double>::infinity(), s_max = 0;
   for (std::size_t i = 0; i < n; ++i) {
     u[i] = b.centres[i] / R;
-    s[i] = b.radii[i] / R;
-    s_min = std::min(s_min, s[i]);
-    s_max = std::max(s_max, s[i]);
+    sr[i] = b.radii[i] / R;
+    s_min = std::min(s_min, sr[i]);
+    s_max = std::max(s_max, sr[i]);
   }
   const double ccov = cos_cover(u);
   // Padded: the region bound must never be too small.
@@ -178,50 +223,20 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
     const Vec3& uj = u[j];
     // j can only win at d with 1 - u_j.d <= delta_cov + s_j - s_min (the nearest centre to d is
     // within the largest empty cap, and it has s >= s_min).
-    const double delta = (delta_cov + (s[j] - s_min)) * (1 + 1e-9) + 1e-15;
+    const double delta = (delta_cov + (sr[j] - s_min)) * (1 + 1e-9) + 1e-15;
     const double c = 1.0 - delta;
     const double S = c > 0 ? std::sqrt(std::max(0.0, 1.0 - c * c)) : 1.0;
-    const double bmax = s_max - s[j];
+    const double bmax = s_max - sr[j];
     double L = c > 0 ? (S + std::sqrt(S * S + 2.0 * c * bmax)) / c : 2.1;
     L = std::min(2.1, L * (1 + 1e-9) + 1e-12);
-    std::vector<HalfSpace> comp;
-    for (std::uint32_t i : q.within(b.centres[j], L * R)) {
-      if (i == j) continue;
-      const Vec3 a = uj - u[i];
-      const double beta = s[i] - s[j];
-      if (c > 0) {
-        // min over the cap region {|x| <= 1, u_j.x >= c} of a.x, on its rim.
-        const double au = a.dot(uj);
-        const double perp = std::sqrt(std::max(0.0, a.squaredNorm() - au * au));
-        if (c * au - S * perp - beta > 1e-13) continue;  // satisfied everywhere in the region
-      }
-      comp.push_back({a, beta});
-    }
+    std::vector<HalfSpace> comp = cap_competitors(b, q, u, sr, j, c, S, L);
     ncomp[j] = static_cast<std::uint32_t>(comp.size());
     // Most threatening (most violated at d = u_j) first: certificates of screening come early.
     std::sort(comp.begin(), comp.end(), [&](const HalfSpace& x, const HalfSpace& y) {
       return x.beta - x.n.dot(uj) > y.beta - y.n.dot(uj);
     });
 
-    // Witness search: over-relaxed projections onto the most violated constraint, on the sphere.
-    Vec3 d = uj;
-    bool won = false;
-    for (int it = 0; it < 200; ++it) {
-      double worst = 0;
-      const HalfSpace* w = nullptr;
-      for (const HalfSpace& h : comp) {
-        const double v = h.n.dot(d) - h.beta;
-        if (v < worst) worst = v, w = &h;
-      }
-      if (!w) {
-        const Support sp = q.support(d);
-        won = support_value(b.centres[j], b.radii[j], d) >= sp.h;
-        break;
-      }
-      d += 1.5 * (-worst / w->n.squaredNorm()) * w->n;
-      d.normalize();
-      if (d.dot(uj) < c) break;  // left the region where j can win
-    }
+    const bool won = cap_witness(b, q, comp, j, uj, c);
     if (won) {
       r.status[j] = Screen::witness;
       continue;
@@ -235,13 +250,119 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
   return r;
 }
 
-ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const BodyScreeningOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
+namespace {
+
+// Local competitors of asperity j: the asperities within a radius holding ~neighbours of them
+// (doubled until at least 4), or all of them on small bodies.
+std::vector<std::uint32_t> local_competitors(const RoughBody& b, const SupportQuery& q, std::uint32_t j, bool all_compete,
+                                             double L0) {
+  std::vector<std::uint32_t> nb;
+  if (all_compete) {
+    nb.resize(b.size());
+    for (std::size_t i = 0; i < b.size(); ++i) nb[i] = static_cast<std::uint32_t>(i);
+    return nb;
+  }
+  double L = L0;
+  for (int t = 0; t < 8; ++t, L *= 2) {
+    nb = q.within(b.centres[j], L);
+    if (nb.size() >= 4) break;
+  }
+  return nb;
+}
+
+// Start direction: normal of the local centre cloud (smallest principal axis), outward.
+Vec3 start_direction(const RoughBody& b, const std::vector<std::uint32_t>& nb, const Vec3& cj) {
+  Vec3 nj = cj.squaredNorm() > 0 ? Vec3(cj.normalized()) : Vec3(0, 0, 1);
+  if (nb.size() >= 3) {
+    Vec3 mean = Vec3::Zero();
+    for (std::uint32_t i : nb) mean += b.centres[i];
+    mean /= static_cast<double>(nb.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (std::uint32_t i : nb) cov += (b.centres[i] - mean) * (b.centres[i] - mean).transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
+    es.computeDirect(cov);
+    const Vec3 v = es.eigenvectors().col(0);
+    if (v.allFinite() && v.squaredNorm() > 0.5) nj = v.normalized();
+  }
+  if (nj.dot(cj) < 0) nj = -nj;
+  return nj;
+}
+
+// Projections onto the most violated half-space, back on the sphere; true once d is in C^S.
+bool relax_on_sphere(const std::vector<HalfSpace>& comp, Vec3& d, int iterations) {
+  for (int it = 0; it < iterations; ++it) {
+    double worst = 0;
+    const HalfSpace* w = nullptr;
+    for (const HalfSpace& h : comp) {
+      const double v = h.n.dot(d) - h.beta;
+      if (v < worst) worst = v, w = &h;
+    }
+    if (!w) return true;
+    // Over-relaxed projection ON the sphere: rotate d towards the plane's normal a, by 1.5 times
+    // the angle that puts it on the boundary (a chord step then a normalisation converges
+    // slowly when the allowed cap is small).
+    const double an = w->n.norm();
+    if (!(an > 0) || w->beta > an) return false;  // infeasible on its own
+    const Vec3 ah = w->n / an;
+    const double c = ah.dot(d);
+    Vec3 t = d - c * ah;
+    const double tn = t.norm();
+    const double phi = std::atan2(tn, c), phit = std::acos(std::max(-1.0, w->beta / an));
+    const double phin = std::max(0.0, phi - 1.5 * (phi - phit) - 1e-13);
+    d = std::cos(phin) * ah + (tn > 0 ? (std::sin(phin) / tn) * t : Vec3(ah.unitOrthogonal() * std::sin(phin)));
+  }
+  return false;
+}
+
+// Relaxation rounds with cutting planes from the exact support query: true if a direction where
+// j wins was found (a witness). Each round's winner, if new, joins the competitors.
+bool find_witness(const RoughBody& b, const SupportQuery& q, std::uint32_t j, std::vector<HalfSpace>& comp,
+                  std::vector<std::uint32_t>& ids, Vec3& d, std::uint32_t max_rounds) {
+  const Vec3& cj = b.centres[j];
+  const double rj = b.radii[j];
+  for (std::uint32_t round = 0; round < max_rounds; ++round) {
+    // Even where the relaxation has not converged (thin cells), the winner at d is a competitor
+    // worth adding: the set grows towards the asperities that close j's cell.
+    const bool feasible = relax_on_sphere(comp, d, round == 0 ? 200 : 48);
+    const Support sp = q.support(d);
+    if (feasible && support_value(cj, rj, d) >= sp.h) return true;
+    // No progress: the winner is already a competitor (d violates its half-space, or rounding).
+    if (sp.index == j || std::find(ids.begin(), ids.end(), sp.index) != ids.end()) return false;
+    comp.push_back({cj - b.centres[sp.index], b.radii[sp.index] - rj});
+    ids.push_back(sp.index);
+  }
+  return false;
+}
+
+// A Helly triple of competitors that misses the ball proves j screened. Tried most violated at d
+// first, as an angle (far competitors have long normals), so certificates come early.
+bool helly_certificate(std::vector<HalfSpace> comp, const Vec3& d) {
+  // x = 0 satisfies every half-space with beta <= 0: C^S meets B, no triple can fail.
+  if (std::all_of(comp.begin(), comp.end(), [](const HalfSpace& h) { return h.beta <= 0; })) return false;
+  std::vector<std::pair<double, std::size_t>> order(comp.size());
+  for (std::size_t i = 0; i < comp.size(); ++i) {
+    const double an = comp[i].n.norm();
+    order[i] = {an > 0 ? (comp[i].beta - comp[i].n.dot(d)) / an : std::numeric_limits<double>::infinity(), i};
+  }
+  std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
+  std::vector<HalfSpace> sorted(comp.size());
+  for (std::size_t i = 0; i < comp.size(); ++i) sorted[i] = comp[order[i].second];
+  return some_triple_misses_ball(nullptr, 0, sorted);
+}
+
+void check_body_screening(const RoughBody& b, const BodyScreeningOptions& o) {
   if (o.neighbours < 3) throw std::invalid_argument("screen_body: neighbours must be >= 3, got " + std::to_string(o.neighbours));
   if (o.max_rounds < 1) throw std::invalid_argument("screen_body: max_rounds must be >= 1, got 0");
   if (b.radii.size() != b.centres.size())
     throw std::invalid_argument("screen_body: body '" + b.name + "' has " + std::to_string(b.centres.size()) + " centres but " +
                                 std::to_string(b.radii.size()) + " radii");
+}
+
+}  // namespace
+
+ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const BodyScreeningOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_body_screening(b, o);
   const std::size_t n = b.size();
   ScreeningResult r;
   r.status.assign(n, Screen::helly);
@@ -258,102 +379,22 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
   for (std::int64_t jj = 0; jj < N; ++jj) {
     const auto j = static_cast<std::uint32_t>(jj);
     const Vec3& cj = b.centres[j];
-    const double rj = b.radii[j];
-    std::vector<std::uint32_t> nb;
-    if (all_compete) {
-      nb.resize(n);
-      for (std::size_t i = 0; i < n; ++i) nb[i] = static_cast<std::uint32_t>(i);
-    } else {
-      double L = L0;
-      for (int t = 0; t < 8; ++t, L *= 2) {
-        nb = q.within(cj, L);
-        if (nb.size() >= 4) break;
-      }
-    }
-    // Start direction: normal of the local centre cloud (smallest principal axis), outward.
-    Vec3 nj = cj.squaredNorm() > 0 ? Vec3(cj.normalized()) : Vec3(0, 0, 1);
-    if (nb.size() >= 3) {
-      Vec3 mean = Vec3::Zero();
-      for (std::uint32_t i : nb) mean += b.centres[i];
-      mean /= static_cast<double>(nb.size());
-      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-      for (std::uint32_t i : nb) cov += (b.centres[i] - mean) * (b.centres[i] - mean).transpose();
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-      es.computeDirect(cov);
-      const Vec3 v = es.eigenvectors().col(0);
-      if (v.allFinite() && v.squaredNorm() > 0.5) nj = v.normalized();
-    }
-    if (nj.dot(cj) < 0) nj = -nj;
-
+    const std::vector<std::uint32_t> nb = local_competitors(b, q, j, all_compete, L0);
     std::vector<HalfSpace> comp;
     std::vector<std::uint32_t> ids;
     comp.reserve(nb.size() + o.max_rounds);
     for (std::uint32_t i : nb) {
       if (i == j) continue;
-      comp.push_back({cj - b.centres[i], b.radii[i] - rj});
+      comp.push_back({cj - b.centres[i], b.radii[i] - b.radii[j]});
       ids.push_back(i);
     }
-    // Projections onto the most violated half-space, back on the sphere; true once d is in C^S.
-    auto relax = [&](Vec3& d, int iterations) {
-      for (int it = 0; it < iterations; ++it) {
-        double worst = 0;
-        const HalfSpace* w = nullptr;
-        for (const HalfSpace& h : comp) {
-          const double v = h.n.dot(d) - h.beta;
-          if (v < worst) worst = v, w = &h;
-        }
-        if (!w) return true;
-        // Over-relaxed projection ON the sphere: rotate d towards the plane's normal a, by 1.5 times
-        // the angle that puts it on the boundary (a chord step then a normalisation converges
-        // slowly when the allowed cap is small).
-        const double an = w->n.norm();
-        if (!(an > 0) || w->beta > an) return false;  // infeasible on its own
-        const Vec3 ah = w->n / an;
-        const double c = ah.dot(d);
-        Vec3 t = d - c * ah;
-        const double tn = t.norm();
-        const double phi = std::atan2(tn, c), phit = std::acos(std::max(-1.0, w->beta / an));
-        const double phin = std::max(0.0, phi - 1.5 * (phi - phit) - 1e-13);
-        d = std::cos(phin) * ah + (tn > 0 ? (std::sin(phin) / tn) * t : Vec3(ah.unitOrthogonal() * std::sin(phin)));
-      }
-      return false;
-    };
-    Vec3 d = nj;
-    bool won = false;
-    for (std::uint32_t round = 0; round < o.max_rounds; ++round) {
-      // Even where the relaxation has not converged (thin cells), the winner at d is a competitor
-      // worth adding: the set grows towards the asperities that close j's cell.
-      const bool feasible = relax(d, round == 0 ? 200 : 48);
-      const Support sp = q.support(d);
-      if (feasible && support_value(cj, rj, d) >= sp.h) {
-        won = true;
-        break;
-      }
-      // No progress: the winner is already a competitor (d violates its half-space, or rounding).
-      if (sp.index == j || std::find(ids.begin(), ids.end(), sp.index) != ids.end()) break;
-      comp.push_back({cj - b.centres[sp.index], b.radii[sp.index] - rj});
-      ids.push_back(sp.index);
-    }
+    Vec3 d = start_direction(b, nb, cj);
+    const bool won = find_witness(b, q, j, comp, ids, d, o.max_rounds);
     ncomp[j] = static_cast<std::uint32_t>(comp.size());
-    if (won) {
+    if (won)
       r.status[j] = Screen::witness;
-      continue;
-    }
-    // x = 0 satisfies every half-space with beta <= 0: C^S meets B, no triple can fail.
-    if (std::all_of(comp.begin(), comp.end(), [](const HalfSpace& h) { return h.beta <= 0; })) continue;
-    // Most violated at d first, as an angle (far competitors have long normals): certificates come early.
-    std::vector<std::pair<double, std::size_t>> order(comp.size());
-    for (std::size_t i = 0; i < comp.size(); ++i) {
-      const double an = comp[i].n.norm();
-      order[i] = {an > 0 ? (comp[i].beta - comp[i].n.dot(d)) / an : std::numeric_limits<double>::infinity(), i};
-    }
-    std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
-    {
-      std::vector<HalfSpace> sorted(comp.size());
-      for (std::size_t i = 0; i < comp.size(); ++i) sorted[i] = comp[order[i].second];
-      comp.swap(sorted);
-    }
-    if (some_triple_misses_ball(nullptr, 0, comp)) r.status[j] = Screen::screened;
+    else if (helly_certificate(comp, d))
+      r.status[j] = Screen::screened;
   }
   tally(r, ncomp);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

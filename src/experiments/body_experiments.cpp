@@ -47,11 +47,11 @@ LawCheck ks_check(const std::string& quantity, const std::vector<double>& sorted
   } catch (const std::exception& ex) {  // a law that cannot be evaluated here: listed, not dropped
     c.ks.D = c.ks.p = kNaN;
     c.ks.n = sorted.size();
-    c.verdict = "skipped";
+    c.verdict = Verdict::skipped;
     c.note += std::string(c.note.empty() ? "" : "; ") + "not tested: cannot be evaluated at these parameters: " + ex.what();
     return c;
   }
-  c.verdict = c.ks.p < alpha ? "reject" : "accept";
+  c.verdict = verdict_at(c.ks.p, alpha);
   return c;
 }
 
@@ -104,12 +104,12 @@ struct ScreeningPool {
 
 bool decisive_rejection(const std::vector<LawCheck>& tests) {
   for (const auto& t : tests)
-    if (t.decisive && t.verdict == "reject") return true;
+    if (t.decisive && t.verdict == Verdict::reject) return true;
   return false;
 }
 std::size_t decisive_skipped(const std::vector<LawCheck>& tests) {
   return static_cast<std::size_t>(
-      std::count_if(tests.begin(), tests.end(), [](const LawCheck& t) { return t.decisive && t.verdict == "skipped"; }));
+      std::count_if(tests.begin(), tests.end(), [](const LawCheck& t) { return t.decisive && t.verdict == Verdict::skipped; }));
 }
 bool RadiiReport::rejected() const { return decisive_rejection(tests); }
 
@@ -172,35 +172,31 @@ RadiiReport finish_lognormal(const RadiiExperiment& e, RadiiReport& r, const std
 }
 }  // namespace
 
-RadiiReport run_radii_experiment(const RadiiExperiment& e, const Progress& progress) {
-  validate(e);
-  RadiiReport r;
-  r.experiment = e;
-  const double R = e.radius, area = 4.0 * std::numbers::pi * R * R;
-  r.lambda = static_cast<double>(e.asperities) / area;
-  const bool lognormal = e.radii.kind == RadiusDistribution::Kind::lognormal;
-  std::vector<double> lv = e.radii.kind == RadiusDistribution::Kind::levels ? e.radii.levels
-                           : lognormal                                       ? std::vector<double>{}
-                                                                             : std::vector<double>{e.radii.radius};
-  std::vector<double> fr = e.radii.kind == RadiusDistribution::Kind::levels ? e.radii.fractions
-                           : lognormal                                       ? std::vector<double>{}
-                                                                             : std::vector<double>{1.0};
-  if (!lv.empty()) {
-    const std::size_t top = static_cast<std::size_t>(std::max_element(lv.begin(), lv.end()) - lv.begin());
-    r.lambda_top = r.lambda * fr[top];
-  } else {
-    r.lambda_top = kNaN;
-  }
-  // Lognormal radii have no exact law here: r_x then comes from M rotations of each screened body
-  // (Stream(seed, orientation, k M + j)), like the "fixed" ensemble.
-  const std::uint64_t M = lognormal ? e.drops / e.screen_bodies : 0;
-  std::vector<double> rx_explicit, rxy_explicit;
+namespace {
 
-  // (1) Screening of explicit bodies.
-  auto t0 = std::chrono::steady_clock::now();
+// The level radii and their fractions (one level for a fixed radius; none for lognormal radii).
+std::pair<std::vector<double>, std::vector<double>> radius_levels(const RadiusDistribution& rd) {
+  switch (rd.kind) {
+    case RadiusDistribution::Kind::levels: return {rd.levels, rd.fractions};
+    case RadiusDistribution::Kind::lognormal: return {{}, {}};
+    default: return {{rd.radius}, {1.0}};
+  }
+}
+
+// r_x, r_xy of M rotations per screened body (lognormal radii only: no exact sampler there).
+struct ExplicitDrops {
+  std::vector<double> rx, rxy;
+};
+
+// (1) Screening of explicit bodies; with lognormal radii also M rotations of each
+// (Stream(seed, orientation, k M + j)), like the "fixed" ensemble.
+ExplicitDrops screen_spheres(const RadiiExperiment& e, const std::vector<double>& lv, RadiiReport& r, const Progress& progress) {
+  const bool lognormal = e.radii.kind == RadiusDistribution::Kind::lognormal;
+  const std::uint64_t M = lognormal ? e.drops / e.screen_bodies : 0;
+  ExplicitDrops x;
   SphereParams p;
   p.asperities = e.asperities;
-  p.radius = R;
+  p.radius = e.radius;
   ScreeningPool pool(lv);
   for (std::uint64_t k = 0; k < e.screen_bodies; ++k) {
     const RoughBody b = make_rough_sphere_body(p, e.radii, e.seed, k);
@@ -216,94 +212,121 @@ RadiiReport run_radii_experiment(const RadiiExperiment& e, const Progress& progr
     r.winners_screened += c.winners_screened;
     r.kept_never_hit += c.kept_never_hit;
     r.directions += c.directions;
-    if (lognormal) {
-      const std::size_t base = rx_explicit.size();
-      rx_explicit.resize(base + M);
-      rxy_explicit.resize(base + M);
-      for_drops(M, k * M, e.drops, progress, [&](std::uint64_t j) {
-        Stream st(e.seed, Purpose::orientation, k * M + j);
-        const Rotation rot = random_rotation(st);
-        const BodyContact bc = make_body_contact(q->support(body_down(rot)), b, rot);
-        rx_explicit[base + static_cast<std::size_t>(j)] = bc.r.x();
-        rxy_explicit[base + static_cast<std::size_t>(j)] = std::hypot(bc.r.x(), bc.r.y());
-      });
-    }
+    if (!lognormal) continue;
+    const std::size_t base = x.rx.size();
+    x.rx.resize(base + M);
+    x.rxy.resize(base + M);
+    for_drops(M, k * M, e.drops, progress, [&](std::uint64_t j) {
+      Stream st(e.seed, Purpose::orientation, k * M + j);
+      const Rotation rot = random_rotation(st);
+      const BodyContact bc = make_body_contact(q->support(body_down(rot)), b, rot);
+      x.rx[base + static_cast<std::size_t>(j)] = bc.r.x();
+      x.rxy[base + static_cast<std::size_t>(j)] = std::hypot(bc.r.x(), bc.r.y());
+    });
   }
   r.kept_fraction_by_level = pool.kept_fraction_by_level();
   if (!pool.lambda_eff.empty()) r.lambda_eff = pool.lambda_eff_mean();
-  r.seconds_screen = seconds_since(t0);
+  return x;
+}
 
-  if (lognormal) return finish_lognormal(e, r, rx_explicit, rxy_explicit);
-
-  // (2) Fresh drops: iid, each a pure function of (seed, drop).
-  t0 = std::chrono::steady_clock::now();
-  std::vector<double> rx(e.drops), rxy(e.drops);
+// (2) Fresh drops, sampled from the exact law of the lowest asperities (level radii): iid, each a
+// pure function of (seed, drop). Fills the winners' level fractions, core contacts and the spread.
+ExplicitDrops fresh_drops(const RadiiExperiment& e, const std::vector<double>& fr, RadiiReport& r, const Progress& progress) {
+  ExplicitDrops x{std::vector<double>(e.drops), std::vector<double>(e.drops)};
   std::vector<std::uint32_t> level(e.drops);
   std::vector<std::uint8_t> core(e.drops);
   for_drops(e.drops, 0, e.drops, progress, [&](std::uint64_t k) {
-    const FreshContact c = fresh_levels_contact(e.asperities, R, e.radii, e.seed, k);
+    const FreshContact c = fresh_levels_contact(e.asperities, e.radius, e.radii, e.seed, k);
     const auto i = static_cast<std::size_t>(k);
-    rx[i] = c.r.x();
-    rxy[i] = std::hypot(c.r.x(), c.r.y());
+    x.rx[i] = c.r.x();
+    x.rxy[i] = std::hypot(c.r.x(), c.r.y());
     level[i] = c.level;
     core[i] = c.core;
   });
-  r.seconds_fresh = seconds_since(t0);
-  t0 = std::chrono::steady_clock::now();
-  r.winner_level_fraction.assign(lv.size(), 0.0);
+  r.winner_level_fraction.assign(fr.size(), 0.0);
   // fresh_levels_contact numbers levels after dropping zero fractions; map back.
   std::vector<std::size_t> nz;
   for (std::size_t m = 0; m < fr.size(); ++m)
     if (fr[m] > 0) nz.push_back(m);
   for (std::size_t i = 0; i < level.size(); ++i) r.winner_level_fraction[nz[level[i]]] += 1.0 / static_cast<double>(e.drops);
   for (auto c : core) r.core_contacts += c;
-  const std::vector<double> probs{0.5};
-  const Summary sx = summarize_iid(rx, probs);
+  const Summary sx = summarize_iid(x.rx, std::vector<double>{0.5});
   r.rx_std = sx.std;
   r.lambda_fit = 1.0 / (2.0 * std::numbers::pi * sx.std.value * sx.std.value);
+  return x;
+}
 
-  // (3) Tests of r_x (the paper's conjecture: Gaussian -- with which lambda?).
-  const auto srx = sorted_copy(rx), srxy = sorted_copy(rxy);
-  const Law exact = levels_sphere_rx(e.asperities, R, e.radii);
-  const Law wrong = levels_sphere_rx(e.asperities, R, e.radii, 1.05);
-  const Law g_all = gaussian_rx(r.lambda, "gauss-lambda");
-  const Law g_top = gaussian_rx(r.lambda_top, "gauss-lambda-top");
-  r.tests.push_back(ks_check("r_x", srx, exact, kNaN, e.alpha, false, "exact finite-N law, level radii"));
+// (3) Tests of r_x (the paper's conjecture: Gaussian -- with which lambda?) and r_xy.
+void level_tests(const RadiiExperiment& e, const ExplicitDrops& x, RadiiReport& r) {
+  const double R = e.radius;
+  const auto srx = sorted_copy(x.rx), srxy = sorted_copy(x.rxy);
+  r.tests.push_back(ks_check("r_x", srx, levels_sphere_rx(e.asperities, R, e.radii), kNaN, e.alpha, false,
+                             "exact finite-N law, level radii"));
   r.tests.back().decisive = true;
-  r.tests.push_back(ks_check("r_x", srx, wrong, kNaN, e.alpha, true, "exact law stretched by 5%: must be rejected"));
-  r.tests.push_back(ks_check("r_x", srx, g_all, r.lambda, e.alpha, false, "Eq. 18 with all asperities"));
+  r.tests.push_back(ks_check("r_x", srx, levels_sphere_rx(e.asperities, R, e.radii, 1.05), kNaN, e.alpha, true,
+                             "exact law stretched by 5%: must be rejected"));
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda, "gauss-lambda"), r.lambda, e.alpha, false, "Eq. 18 with all asperities"));
   if (r.lambda_eff.value > 0)
     r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_eff.value, "gauss-lambda-eff"), r.lambda_eff.value, e.alpha,
                                false, "Eq. 18 with the density of asperities that can touch (screening)"));
-  r.tests.push_back(ks_check("r_x", srx, g_top, r.lambda_top, e.alpha, false, "Eq. 18 with the largest level only"));
+  r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_top, "gauss-lambda-top"), r.lambda_top, e.alpha, false,
+                             "Eq. 18 with the largest level only"));
   r.tests.push_back(ks_check("r_x", srx, gaussian_rx(r.lambda_fit, "gauss-lambda-fit"), r.lambda_fit, e.alpha, false,
                              "Gaussian with the sample variance (fitted: p is optimistic)"));
   r.tests.push_back(ks_check("r_xy", srxy, levels_sphere_rxy(e.asperities, R, e.radii), kNaN, e.alpha, false,
                              "exact finite-N law of r_xy"));
   r.tests.back().decisive = true;
-  r.seconds_analysis = seconds_since(t0);
+}
 
-  // (4) Figures.
-  t0 = std::chrono::steady_clock::now();
-  if (e.plots) {
-    const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * std::min(r.lambda_top, r.lambda_fit));
-    const double hi = 4.0 * sigma;
-    HistogramFigure fig;
-    std::ostringstream t;
-    t << "r_x, N = " << e.asperities << ", radii " << e.radii.describe() << ", " << e.drops << " fresh drops";
-    fig.title = t.str();
-    fig.xlabel = "r_x [{/Symbol m}m]";
-    fig.ylabel = "probability density [1/{/Symbol m}m]";
-    fig.x_scale = 1e6;
-    fig.y_scale = 1e-6;
-    fig.histogram = make_histogram(rx, -hi, hi, 60);
-    fig.curves.push_back(curve_of(exact, "exact law, level radii", -hi, hi));
-    fig.curves.push_back(curve_of(g_all, "Eq. (18), {/Symbol l} of all asperities", -hi, hi));
-    if (r.lambda_eff.value > 0)
-      fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), {/Symbol l}_{eff} (screening)", -hi, hi));
-    fig.curves.push_back(curve_of(g_top, "Eq. (18), {/Symbol l} of the largest level", -hi, hi));
-    r.figures.push_back({"r_x.png", std::move(fig)});
+// (4) r_x against the exact level law and the Gaussians.
+HistogramFigure level_figure(const RadiiExperiment& e, const ExplicitDrops& x, const RadiiReport& r) {
+  const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * std::min(r.lambda_top, r.lambda_fit));
+  const double hi = 4.0 * sigma;
+  HistogramFigure fig;
+  std::ostringstream t;
+  t << "r_x, N = " << e.asperities << ", radii " << e.radii.describe() << ", " << e.drops
+    << " fresh drops (sampled from the exact law)";
+  fig.title = t.str();
+  fig.xlabel = "r_x [{/Symbol m}m]";
+  fig.ylabel = "probability density [1/{/Symbol m}m]";
+  fig.x_scale = 1e6;
+  fig.y_scale = 1e-6;
+  fig.histogram = make_histogram(x.rx, -hi, hi, 60);
+  fig.curves.push_back(curve_of(levels_sphere_rx(e.asperities, e.radius, e.radii), "exact law, level radii", -hi, hi));
+  fig.curves.push_back(curve_of(gaussian_rx(r.lambda, "gauss-lambda"), "Eq. (18), {/Symbol l} of all asperities", -hi, hi));
+  if (r.lambda_eff.value > 0)
+    fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), {/Symbol l}_{eff} (screening)", -hi, hi));
+  fig.curves.push_back(curve_of(gaussian_rx(r.lambda_top, "gauss-lambda-top"), "Eq. (18), {/Symbol l} of the largest level", -hi, hi));
+  return fig;
+}
+
+}  // namespace
+
+RadiiReport run_radii_experiment(const RadiiExperiment& e, const Progress& progress) {
+  validate(e);
+  RadiiReport r;
+  r.experiment = e;
+  r.lambda = static_cast<double>(e.asperities) / (4.0 * std::numbers::pi * e.radius * e.radius);
+  const auto [lv, fr] = radius_levels(e.radii);
+  if (!lv.empty()) {
+    const std::size_t top = static_cast<std::size_t>(std::max_element(lv.begin(), lv.end()) - lv.begin());
+    r.lambda_top = r.lambda * fr[top];
+  } else {
+    r.lambda_top = kNaN;
   }
+  auto t0 = std::chrono::steady_clock::now();
+  ExplicitDrops rotated = screen_spheres(e, lv, r, progress);
+  r.seconds_screen = seconds_since(t0);
+  if (e.radii.kind == RadiusDistribution::Kind::lognormal) return finish_lognormal(e, r, rotated.rx, rotated.rxy);
+
+  t0 = std::chrono::steady_clock::now();
+  const ExplicitDrops fresh = fresh_drops(e, fr, r, progress);
+  r.seconds_fresh = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  level_tests(e, fresh, r);
+  r.seconds_analysis = seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
+  if (e.plots) r.figures.push_back({"r_x.png", level_figure(e, fresh, r)});
   r.seconds_plots = seconds_since(t0);
   return r;
 }
@@ -493,7 +516,7 @@ std::vector<Law> eps_tests(const MeshImpactExperiment& e, const MeshDrops& D, co
       c.law = q == std::string("eps") ? "eq28-corrected" : "eq33-corrected";
       c.lambda = c.ks.D = c.ks.p = kNaN;
       c.ks.n = D.e_ok.size();
-      c.verdict = "skipped";
+      c.verdict = Verdict::skipped;
       c.note = std::string("not tested: cannot be evaluated at these parameters: ") + ex.what();
       r.tests.push_back(c);
     }

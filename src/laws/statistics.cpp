@@ -10,6 +10,7 @@
 #include <limits>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -350,8 +351,9 @@ Histogram make_histogram(std::span<const double> x, double lo, double hi, std::s
   return h;
 }
 
-Chi2Result chi2_test(const Histogram& h, const Cdf& cdf, double min_expected) {
-  const char* who = "chi2_test";
+namespace {
+
+void check_chi2_input(const Histogram& h, const Cdf& cdf, double min_expected) {
   if (!cdf) fail("chi2_test: empty cdf");
   if (!(min_expected > 0) || !std::isfinite(min_expected))
     fail("chi2_test: min_expected must be finite and > 0, got " + str(min_expected));
@@ -369,8 +371,12 @@ Chi2Result chi2_test(const Histogram& h, const Cdf& cdf, double min_expected) {
   const double N = static_cast<double>(h.total);
   if (std::fabs(sum - N) > 1e-9 * N + 0.5)
     fail("chi2_test: counts + under + over = " + str(sum) + " differs from total = " + str(N));
+}
 
-  // Cells: under, bins..., over, with expected counts from cdf differences.
+// Observed and expected counts per cell: under, bins..., over, expected from cdf differences.
+std::pair<std::vector<double>, std::vector<double>> chi2_cells(const Histogram& h, const Cdf& cdf) {
+  const char* who = "chi2_test";
+  const double N = static_cast<double>(h.total);
   const std::size_t B = h.counts.size();
   std::vector<double> obs, expct;
   obs.reserve(B + 2);
@@ -394,9 +400,13 @@ Chi2Result chi2_test(const Histogram& h, const Cdf& cdf, double min_expected) {
   }
   obs.push_back(static_cast<double>(h.over));
   expct.push_back(N * (1.0 - Fprev));
+  return {obs, expct};
+}
 
-  // Merge left to right until each cell expects >= min_expected; a short remainder at the end
-  // joins the last complete cell.
+// Merge left to right until each cell expects >= min_expected; a short remainder at the end joins
+// the last complete cell.
+std::pair<std::vector<double>, std::vector<double>> merge_cells(const std::vector<double>& obs, const std::vector<double>& expct,
+                                                                double min_expected) {
   std::vector<double> mo, me;
   double co = 0, ce = 0;
   for (std::size_t i = 0; i < obs.size(); ++i) {
@@ -417,7 +427,15 @@ Chi2Result chi2_test(const Histogram& h, const Cdf& cdf, double min_expected) {
       me.back() += ce;
     }
   }
+  return {mo, me};
+}
 
+}  // namespace
+
+Chi2Result chi2_test(const Histogram& h, const Cdf& cdf, double min_expected) {
+  check_chi2_input(h, cdf, min_expected);
+  const auto [obs, expct] = chi2_cells(h, cdf);
+  const auto [mo, me] = merge_cells(obs, expct, min_expected);
   Chi2Result r;
   r.dof = static_cast<int>(mo.size()) - 1;
   if (mo.size() < 2) {

@@ -14,6 +14,7 @@
 #include "asperity/core/mesh.hpp"
 #include "asperity/laws/figure.hpp"
 #include "asperity/laws/statistics.hpp"
+#include "asperity/laws/verdict.hpp"
 
 namespace asperity {
 
@@ -27,7 +28,7 @@ struct LawCheck {
   /// An exact finite-N law: its rejection fails the run (exit status 1). The paper's laws applied
   /// to other radii or bodies are measurements, not pass/fail.
   bool decisive = false;
-  std::string verdict;      ///< "accept" / "reject" / "skipped" (the law could not be evaluated)
+  Verdict verdict = Verdict::skipped;  ///< accept / reject / skipped (the law could not be evaluated)
   std::string note;
 };
 
