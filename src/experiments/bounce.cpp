@@ -420,9 +420,9 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
           // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
           // when floor > alpha that is no verdict (the group can never reject at this B).
           const double floor = 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap));
-          g.gof_verdict = g.gof.p <= b.alpha ? "reject"
-                          : (g.gof.p <= floor * (1 + 1e-9) && floor > b.alpha) ? "cannot decide at this B"
-                                                                                : "accept";
+          g.gof_verdict = verdict_at(g.gof.p, b.alpha);
+          if (g.gof_verdict == Verdict::accept && g.gof.p <= floor * (1 + 1e-9) && !(floor < b.alpha))
+            g.gof_verdict = Verdict::undecided;
         } else {
           g.gof.p = std::numeric_limits<double>::quiet_NaN(), g.gof.D = 0;
         }

@@ -244,7 +244,7 @@ TEST(Bounce, SecVPaperProcedureHasTheMarginalButKeepsTheSpinSign) {
 
 TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
   // A Gaussian sample of 4000 is not Laplace (KS D ~ 0.03, far beyond the bootstrap's replicates).
-  // With B = 19 the smallest p is 1/20 > alpha = 0.01: the group must be "cannot decide at this B",
+  // With B = 19 the smallest p is 1/20 > alpha = 0.01: the group must be undecided ("cannot decide at this B"),
   // never "accept"; with B = 199 (floor 0.005) the same data are rejected. A Laplace sample of the
   // same size is accepted at B = 19.
   auto make = [](bool laplace) {
@@ -269,13 +269,13 @@ TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
   ASSERT_EQ(r.groups.size(), 1u);
   EXPECT_EQ(r.groups[0].gof.bootstrap, 19u);
   EXPECT_NEAR(r.groups[0].gof.p, 0.05, 1e-12);
-  EXPECT_EQ(r.groups[0].gof_verdict, "cannot decide at this B");
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::undecided);
   b.bootstrap = 199;
   r = analyse_bounces(gauss, b, 7);
-  EXPECT_EQ(r.groups[0].gof_verdict, "reject");
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::reject);
   b.bootstrap = 19;
   r = analyse_bounces(make(true), b, 7);
-  EXPECT_EQ(r.groups[0].gof_verdict, "accept") << "p = " << r.groups[0].gof.p;
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::accept) << "p = " << r.groups[0].gof.p;
 }
 
 TEST(Bounce, ValidationNamesTheField) {

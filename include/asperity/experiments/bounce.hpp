@@ -45,6 +45,7 @@
 #include "asperity/core/geometry.hpp"
 #include "asperity/laws/laplace.hpp"
 #include "asperity/laws/statistics.hpp"
+#include "asperity/laws/verdict.hpp"
 
 namespace asperity {
 
@@ -70,7 +71,7 @@ struct BounceExperiment {
   std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
                                   ///< max(19, 2e7/n): the work is B n; the count used is reported)
   /// Level of the goodness-of-fit verdicts: a group whose bootstrap found no replicate as far from
-  /// its fit as the data (p at its floor 1/(1+B)) while 1/(1+B) > alpha is "cannot decide at this B".
+  /// its fit as the data (p at its floor 1/(1+B)) while 1/(1+B) >= alpha is undecided.
   double alpha = 0.01;
   /// Impact-speed windows [lo, hi] [m/s]: p(eps | u) with the history marginalised as the experiment
   /// does; membership depends on the past (u_k = u_1 prod eps_j), see bounce_grouping_note().
@@ -137,9 +138,9 @@ struct BounceGroup {
   bool fitted = false;         ///< n >= 20
   LaplaceFit fit;
   LaplaceGof gof;
-  /// "accept", "reject" (p <= alpha) or "cannot decide at this B" (no replicate reached D and the
-  /// floor 1/(1+B) > alpha); "" without a bootstrap.
-  std::string gof_verdict;
+  /// accept, reject (p < alpha) or undecided ("cannot decide at this B": no replicate reached D and
+  /// the floor 1/(1+B) is not below alpha); skipped without a bootstrap.
+  Verdict gof_verdict = Verdict::skipped;
   /// The residual eps - eps_n(u_k) of every group (for speed windows the same as `quantity`):
   /// mean, sd, Eq. 2 fit (no bootstrap) and its correlation with the impact speed u_k (se 1/sqrt(n)).
   Estimate residual_mean;
