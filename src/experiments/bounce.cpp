@@ -412,9 +412,14 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
       try {
         g.fit = fit_asymmetric_laplace_sorted(g.sorted);
         g.fitted = true;
-        // Bootstrap work is B n: cap it at 2e7 draws (B >= 19, p resolution 0.05) for the big
-        // low-speed windows, where any misfit is decided by D >> 1/sqrt(n) anyway.
-        const std::size_t B = std::min<std::size_t>(b.bootstrap, std::max<std::size_t>(19, 20000000 / g.n));
+        // B adapts up to the smallest count whose floor 1/(1+B) is below alpha (ceil(1/alpha): 100 at
+        // alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
+        // for the big low-speed windows; a group left with floor >= alpha is undecided when no
+        // replicate reaches D (below), never accepted.
+        const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
+        const std::size_t B = b.bootstrap == 0 ? 0
+                                               : std::min<std::size_t>(std::max(b.bootstrap, B_floor),
+                                                                       std::max<std::size_t>(19, 20000000 / g.n));
         if (b.bootstrap > 0) {
           g.gof = laplace_gof(g.sorted, g.fit, B, seed, index);
           // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;

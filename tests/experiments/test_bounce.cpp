@@ -244,9 +244,10 @@ TEST(Bounce, SecVPaperProcedureHasTheMarginalButKeepsTheSpinSign) {
 
 TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
   // A Gaussian sample of 4000 is not Laplace (KS D ~ 0.03, far beyond the bootstrap's replicates).
-  // With B = 19 the smallest p is 1/20 > alpha = 0.01: the group must be undecided ("cannot decide at this B"),
-  // never "accept"; with B = 199 (floor 0.005) the same data are rejected. A Laplace sample of the
-  // same size is accepted at B = 19.
+  // B adapts to ceil(1/alpha) so that the floor 1/(1+B) is below alpha: at alpha = 0.01 a requested
+  // B = 19 becomes 100 and the misfit is rejected (p = 1/101). Where the work budget B n <= 2e7 caps
+  // B below that (alpha = 1e-4 needs 10^4 replicates, the budget allows 5000 at n = 4000) the group is
+  // undecided ("cannot decide at this B"), never accepted. A Laplace sample is accepted.
   auto make = [](bool laplace) {
     BounceSamples s;
     s.variant = BounceVariant::paper_corrected28;
@@ -262,18 +263,18 @@ TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
     return s;
   };
   auto b = small(4000);
-  b.windows.clear(), b.impact_numbers = {1}, b.alpha = 0.01;
-  b.bootstrap = 19;
+  b.windows.clear(), b.impact_numbers = {1}, b.alpha = 0.01, b.bootstrap = 19;
   const auto gauss = make(false);
   auto r = analyse_bounces(gauss, b, 7);
   ASSERT_EQ(r.groups.size(), 1u);
-  EXPECT_EQ(r.groups[0].gof.bootstrap, 19u);
-  EXPECT_NEAR(r.groups[0].gof.p, 0.05, 1e-12);
-  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::undecided);
-  b.bootstrap = 199;
+  EXPECT_EQ(r.groups[0].gof.bootstrap, 100u);
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::reject) << "p = " << r.groups[0].gof.p;
+  b.alpha = 1e-4;
   r = analyse_bounces(gauss, b, 7);
-  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::reject);
-  b.bootstrap = 19;
+  EXPECT_EQ(r.groups[0].gof.bootstrap, 5000u);
+  EXPECT_NEAR(r.groups[0].gof.p, 1.0 / 5001, 1e-15);
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::undecided);
+  b.alpha = 0.01;
   r = analyse_bounces(make(true), b, 7);
   EXPECT_EQ(r.groups[0].gof_verdict, Verdict::accept) << "p = " << r.groups[0].gof.p;
 }
