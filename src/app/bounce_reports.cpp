@@ -54,7 +54,7 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
         m = fmt(g.by == "speed" ? "%.3e" : "%.8f", g.fit.m.value) + " +- " + fmt("%.1e", g.fit.m.se);
         a = fmt("%.3f", g.fit.a.value / unit) + " +- " + fmt("%.3f", g.fit.a.se / unit);
         c = fmt("%.3f", g.fit.c.value / unit) + " +- " + fmt("%.3f", g.fit.c.se / unit);
-        D = fmt("%.4f", g.gof.D), p = fmt("%.2f", g.gof.p);
+        D = fmt("%.4f", g.gof.D), p = fmt("%.2f", g.gof.p) + (g.gof_verdict == Verdict::undecided ? "?" : "");
       }
       std::snprintf(line, sizeof line, "%-18s %-13s %8zu %6.3f %-22s %-24s %-18s %-18s %8s %6s\n",
                     std::string(to_string(r.variant)).c_str(), grp.c_str(), g.n, g.mean_speed, mean.c_str(), m.c_str(),
@@ -72,8 +72,38 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
                   r.spin_final_mean);
     o << line;
   }
-  o << "a, c: rates of the asymmetric Laplace law (Eq. 2) left/right of the mode [1]; KS p from a parametric bootstrap.\n"
+  o << "a, c: rates of the asymmetric Laplace law (Eq. 2) left/right of the mode [1]; KS p from a parametric bootstrap\n"
+       "(p? = undecided: no replicate reached D and 1/(1+B) >= alpha, cannot decide at this B, not an acceptance).\n"
        "Speed windows fit eps - eps_n(u) (eps_n of Eq. 9 at the impact speed), impact numbers k fit eps itself.\n";
+  // The residual eps - eps_n(u) in every group against the semi-analytic law (theory_impact.hpp).
+  bool any_theory = false;
+  for (const auto& r : reports)
+    for (const auto& g : r.groups) any_theory = any_theory || g.residual_fitted;
+  if (any_theory) {
+    std::snprintf(line, sizeof line, "\n%-18s %-13s %-10s %-9s %-19s %-19s %-17s %-8s %-8s %-16s\n", "variant", "group", "res mean",
+                  "res sd", "a fit (theory)", "c fit (theory)", ("[" + scale.substr(1, scale.size() - 2) + "]").c_str(), "KS D",
+                  "KS p", "corr(u, res)");
+    o << line << std::string(150, '-') << "\n";
+    for (const auto& r : reports)
+      for (const auto& g : r.groups) {
+        if (!g.residual_fitted) continue;
+        const std::string grp = g.by == "speed" ? "u in [" + fmt("%.1f", g.lo) + "," + fmt("%.1f", g.hi) + "]" : "k = " + fmt("%.0f", g.lo);
+        auto rate = [&](double fit, double th) {
+          std::string x = fmt("%.3f", fit / unit);
+          if (g.has_theory && th > 0) x += " (" + (std::isfinite(th) ? fmt("%.3f", th / unit) : std::string("inf")) + ")";
+          return x;
+        };
+        std::snprintf(line, sizeof line, "%-18s %-13s %-10s %-9s %-19s %-19s %-17s %-8s %-8s %-16s\n",
+                      std::string(to_string(r.variant)).c_str(), grp.c_str(), fmt("%.3e", g.residual_mean.value).c_str(),
+                      fmt("%.2e", g.residual_std).c_str(), rate(g.residual_fit.a.value, g.theory_rate_below).c_str(),
+                      rate(g.residual_fit.c.value, g.theory_rate_above).c_str(), "",
+                      g.has_theory ? fmt("%.4f", g.theory_ks.D).c_str() : "-", g.has_theory ? fmt("%.2g", g.theory_ks.p).c_str() : "-",
+                      (fmt("%+.4f", g.speed_residual_correlation.value) + " +- " + fmt("%.4f", g.speed_residual_correlation.se)).c_str());
+        o << line;
+      }
+    o << "res = eps - eps_n(u_k); a, c fit: Eq. 2 fitted to res (no bootstrap); (theory): rates of the semi-analytic law at "
+         "impact k (bounce_residual_laws; paper: with Eq. 26's beta1); KS D, p: res against that law (speed windows: its mixture over k).\n";
+  }
   return o.str();
 }
 
@@ -125,9 +155,23 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
                     {"a", f.a.value}, {"a_se", jnum(f.a.se)}, {"c", f.c.value}, {"c_se", jnum(f.c.se)},
                     {"log_likelihood", f.log_likelihood}, {"se_method", "Fisher information"}};
         x["ks"] = {{"statistic", "KS"}, {"D", g.gof.D}, {"p", jnum(g.gof.p)}, {"bootstrap", g.gof.bootstrap},
-                   {"p_method", "parametric bootstrap (parameters refitted)"}, {"decisive", false}};
+                   {"p_method", "parametric bootstrap (parameters refitted)"}, {"decisive", false},
+                   {"p_floor", g.gof.bootstrap ? 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap)) : 1.0},
+                   {"verdict", std::string(to_string(g.gof_verdict))}};
       } else {
         x["fit"] = nullptr, x["ks"] = nullptr;
+      }
+      if (g.residual_fitted) {
+        const auto& f = g.residual_fit;
+        x["residual"] = {{"quantity", "eps-eps_n(u)"}, {"mean", jnum(g.residual_mean.value)}, {"mean_se", jnum(g.residual_mean.se)},
+                         {"std", jnum(g.residual_std)}, {"fit", {{"m", f.m.value}, {"a", f.a.value}, {"a_se", jnum(f.a.se)},
+                                                                  {"c", f.c.value}, {"c_se", jnum(f.c.se)}}},
+                         {"speed_correlation", jnum(g.speed_residual_correlation.value)},
+                         {"speed_correlation_se", jnum(g.speed_residual_correlation.se)}};
+        if (g.has_theory)
+          x["residual"]["theory"] = {{"law", "semi-analytic asymmetric Laplace (planar spin random walk x Gaussian offset)"},
+                                     {"rate_below", jnum(g.theory_rate_below)}, {"rate_above", jnum(g.theory_rate_above)},
+                                     {"ks_D", g.theory_ks.D}, {"ks_p", jnum(g.theory_ks.p)}};
       }
       groups.push_back(std::move(x));
     }
@@ -148,6 +192,7 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
                  {"beta", b.beta},
                  {"eps_t", b.eps_t},
                  {"bootstrap", b.bootstrap},
+                 {"alpha", b.alpha},
                  {"eps_time_note", "eps(times) = T_k / T_(k-1) from the flight times before and after impact k; it differs "
                                    "from eps = V'_z/V_z by the height differences of successive lowest points"}};
   return j.dump(2) + "\n";

@@ -180,7 +180,9 @@ SceneOutput run_bounce(const Scene& s, std::ostream* log, const std::filesystem:
   const auto& e = s.ensemble;
   SceneOutput o;
   auto t0 = Clock::now();
-  const auto reports = run_bounce_experiment(e.sphere, s.bounce, e.seed, e.threads, log);
+  auto bounce = s.bounce;
+  bounce.alpha = s.alpha;  // the verdicts of the Eq. 2 bootstrap use the scene's level
+  const auto reports = run_bounce_experiment(e.sphere, bounce, e.seed, e.threads, log);
   const double seconds_bounce = since(t0);
   t0 = Clock::now();
   const auto comparisons = compare_bounce_variants(reports);

@@ -202,6 +202,29 @@ class Reader {
     }
     return out;
   }
+  // [[lo, hi], ...]: non-empty array of number pairs (the bounce speed windows).
+  std::optional<std::vector<std::pair<double, double>>> pairs(std::string_view k) {
+    const toml::node* n = find(k);
+    if (!n) return std::nullopt;
+    auto a = n->as_array();
+    if (!a || a->empty()) bad(k, "expected a non-empty array of [lo, hi] pairs, got " + show(*n));
+    std::vector<std::pair<double, double>> out;
+    for (std::size_t i = 0; i < a->size(); ++i) {
+      auto p = a->get(i)->as_array();
+      if (!p || p->size() != 2) bad(k, "element " + std::to_string(i) + " must be a pair [lo, hi], got " + show(*a->get(i)));
+      double v[2] = {0, 0};
+      for (std::size_t j = 0; j < 2; ++j) {
+        const toml::node& e = *p->get(j);
+        if (auto f = e.as_floating_point()) v[j] = f->get();
+        else if (auto m = e.as_integer()) v[j] = static_cast<double>(m->get());
+        else bad(k, "element " + std::to_string(i) + " must hold numbers, got " + show(e));
+      }
+      if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !(v[0] >= 0) || !(v[0] < v[1]))
+        bad(k, "element " + std::to_string(i) + " must satisfy 0 <= lo < hi (finite), got " + show(*a->get(i)));
+      out.push_back({v[0], v[1]});
+    }
+    return out;
+  }
   // A sub-table (a [section] or an inline { ... } table).
   std::optional<Reader> table(std::string_view k) {
     const toml::node* n = find(k);
@@ -530,6 +553,15 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
           ex->bad("variants", err.what());
         }
       }
+      // Groups of the analysis (defaults: bounce.hpp), e.g. to match an experiment's impact speeds.
+      if (auto w = ex->pairs("speed_windows")) s.bounce.windows = *w;
+      if (auto g = ex->reals("impact_groups")) {
+        s.bounce.impact_numbers.clear();
+        for (double k : *g) {
+          if (!(k >= 1) || k != std::floor(k) || k > 1e9) ex->bad("impact_groups", "impact numbers are whole numbers >= 1, got " + num(k));
+          s.bounce.impact_numbers.push_back(static_cast<unsigned>(k));
+        }
+      }
       if (!(s.bounce.stop_speed < s.bounce.speed))
         ex->bad("stop_speed", "must be below speed = " + num(s.bounce.speed) + " m/s, got " + num(s.bounce.stop_speed));
       // A body bounces one way: its orientation carried by the free rotation (body_bounce.hpp).
@@ -542,7 +574,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
         ex->bad("Omega", "only for body.kind = \"mesh\": the sphere's bounce variants start without spin (Sec. V)");
       }
     } else {
-      for (const char* k : {"speed", "stop_speed", "gravity", "sequences", "variants"})
+      for (const char* k : {"speed", "stop_speed", "gravity", "sequences", "variants", "speed_windows", "impact_groups"})
         if (ex->has(k)) ex->bad(k, "only for kind = \"bounce\"");
     }
     if (impacts) {
@@ -833,6 +865,16 @@ std::string to_toml(const Scene& s) {
     for (std::size_t i = 0; i < b.variants.size(); ++i) os << (i ? "," : "") << to_string(b.variants[i]);
     os << "\"\n";
     if (s.mesh) os << "Omega = [" << num(b.omega.x()) << ", " << num(b.omega.y()) << ", " << num(b.omega.z()) << "]\n";
+    if (b.windows != BounceExperiment{}.windows) {
+      os << "speed_windows = [";
+      for (std::size_t i = 0; i < b.windows.size(); ++i) os << (i ? ", " : "") << "[" << num(b.windows[i].first) << ", " << num(b.windows[i].second) << "]";
+      os << "]\n";
+    }
+    if (b.impact_numbers != BounceExperiment{}.impact_numbers) {
+      os << "impact_groups = [";
+      for (std::size_t i = 0; i < b.impact_numbers.size(); ++i) os << (i ? ", " : "") << b.impact_numbers[i];
+      os << "]\n";
+    }
     os << "\n";
   } else if (x.enabled) {
     os << "[experiment]\nkind = \"impact\"\nV = [0.0, 0.0, " << num(-x.speed) << "]\nOmega = [" << num(x.omega.x())

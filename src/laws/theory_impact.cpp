@@ -138,7 +138,7 @@ Setup setup(const ImpactScene& s) {
   const auto en = viscoelastic_pade14(s.beta);
   p.lambda = areal_density(s.asperities, x.R);
   p.sigma = 1.0 / std::sqrt(2.0 * pi * p.lambda);
-  p.inertia = 0.4 * x.R * x.R;
+  p.inertia = 0.4 * (s.literal_eq23 ? x.a * x.a : x.R * x.R);
   const double rz = x.R + x.a;
   p.c2 = p.inertia + rz * rz;
   p.eps_n = (*en)(x.u);
@@ -641,6 +641,42 @@ Law eq28_printed(const ImpactScene& s) {
     law.mean = P->thi;
   }
   return law;
+}
+
+// =====================================================================================
+double eq28_paper_route_eps(const ImpactLawParameters& p, double u, double omega_x, double s) {
+  const double c2 = p.c2, e = p.eps_n;
+  return e + (1.0 + e) * s * (omega_x * c2 - u * s) / (u * (s * s + c2));
+}
+
+double BounceResidualLaw::cdf(double t) const {
+  const double tot = a1 + a2;
+  if (t < 0) return a1 / tot * std::exp(t / a1);
+  if (a2 == 0) return 1.0;
+  return 1.0 - a2 / tot * std::exp(-t / a2);
+}
+
+std::vector<BounceResidualLaw> bounce_residual_laws(const ImpactScene& s0, unsigned k_max, bool paper_route) {
+  ImpactScene s = s0;
+  s.omega_x = s.omega_y = 0;
+  s.core_contacts = false;
+  std::vector<BounceResidualLaw> out;
+  double u = s.speed, S2 = 0;
+  for (unsigned k = 1; k <= k_max; ++k) {
+    s.speed = u;
+    const auto p = impact_law_parameters(s);
+    BounceResidualLaw L;
+    L.k = k, L.speed = u, L.eps_n = p.eps_n, L.spin_sd = std::sqrt(S2);
+    const double beta1 = (1.0 + p.eps_n) / u + (paper_route ? 0.0 : p.eps_n_prime);
+    L.tau = beta1 * L.spin_sd / (2.0 * p.alpha);
+    const double s2 = p.sigma * p.sigma, lp = 0.5 * (s2 + std::sqrt(s2 * s2 + 4.0 * s2 * L.tau * L.tau));
+    const double lm = -s2 * L.tau * L.tau / lp;  // lambda_+ lambda_- = -sigma^2 tau^2, no cancellation
+    L.a1 = 2.0 * p.alpha * lp, L.a2 = -2.0 * p.alpha * lm;
+    out.push_back(L);
+    S2 += p.sigma_c * p.sigma_c;
+    u *= p.eps_n - 2.0 * p.alpha * s2;
+  }
+  return out;
 }
 
 }  // namespace asperity

@@ -521,3 +521,20 @@ TEST(SceneFileBodies, MeshBounceScenes) {
   sphere.bounce.omega = Vec3(0.1, 0, 0);
   EXPECT_THROW(validate(sphere), std::invalid_argument);
 }
+
+// Sec. V groups are scene-selectable (issue 15); the defaults stay those of BounceExperiment.
+TEST(SceneFile, BounceGroupsAreSelectable) {
+  const std::string base = replace(kGood, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"bounce\"\nsequences = 20");
+  const Scene d = parse_scene(base);
+  EXPECT_EQ(d.bounce.windows, BounceExperiment{}.windows);
+  EXPECT_EQ(d.bounce.impact_numbers, BounceExperiment{}.impact_numbers);
+  const Scene s = parse_scene(replace(base, "sequences = 20", "sequences = 20\nspeed_windows = [[0.2, 0.25], [0.5, 0.55]]\nimpact_groups = [1, 3, 7]"));
+  EXPECT_EQ(s.bounce.windows, (std::vector<std::pair<double, double>>{{0.2, 0.25}, {0.5, 0.55}}));
+  EXPECT_EQ(s.bounce.impact_numbers, (std::vector<unsigned>{1, 3, 7}));
+  expect_round_trips({s});
+  expect_error(replace(base, "sequences = 20", "sequences = 20\nspeed_windows = [[0.5, 0.4]]"), "experiment.speed_windows", "lo < hi");
+  expect_error(replace(base, "sequences = 20", "sequences = 20\nspeed_windows = [0.5, 0.6]"), "experiment.speed_windows", "pair");
+  expect_error(replace(base, "sequences = 20", "sequences = 20\nimpact_groups = [0, 2]"), "experiment.impact_groups", ">= 1");
+  expect_error(replace(base, "sequences = 20", "sequences = 20\nimpact_groups = [2.5]"), "experiment.impact_groups", "whole");
+  expect_error(replace(kGood, "V = [0.0, 0.0, -1.3]", "V = [0.0, 0.0, -1.3]\nimpact_groups = [1]"), "experiment.impact_groups", "bounce");
+}

@@ -9,10 +9,14 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 
 #include "asperity/experiments/bounce.hpp"
+#include "asperity/core/random.hpp"
 #include "asperity/core/restitution.hpp"
+#include "asperity/laws/laplace.hpp"
+#include "asperity/laws/statistics.hpp"
 #include "asperity/laws/theory_impact.hpp"
 
 using namespace asperity;
@@ -146,6 +150,133 @@ TEST(Bounce, FirstImpactIsOneSidedWithThePredictedDeficit) {
   const double want = 2 * p.alpha * p.sigma * p.sigma;
   EXPECT_LT(std::abs(mean - want), 4 * se) << mean << " vs " << want;
   EXPECT_GT(std::abs(mean - 1.1 * want), 4 * se);
+}
+
+namespace {
+// Residuals eps - eps_n(u) of impact k, sorted.
+std::vector<double> residuals_at(const BounceSamples& s, unsigned k, double beta) {
+  const auto en = viscoelastic_pade14(beta);
+  std::vector<double> r;
+  for (std::size_t j = 0; j < s.eps.size(); ++j)
+    if (s.number[j] == k) r.push_back(s.eps[j] - (*en)(s.speed[j]));
+  std::sort(r.begin(), r.end());
+  return r;
+}
+BounceResidualLaw with_tau(BounceResidualLaw L, double sigma, double alpha, double tau) {
+  const double s2 = sigma * sigma, lp = 0.5 * (s2 + std::sqrt(s2 * s2 + 4 * s2 * tau * tau));
+  L.tau = tau, L.a1 = 2 * alpha * lp, L.a2 = 2 * alpha * s2 * tau * tau / lp;
+  return L;
+}
+}  // namespace
+
+TEST(Bounce, SecVResidualAfterTheFirstImpactFollowsTheSemiAnalyticLaw) {
+  // Explicit geometry with independent contacts (random-orientation): the residual at impact k is
+  // the asymmetric Laplace law of bounce_residual_laws (planar spin random walk x Gaussian offset).
+  // 3000 sequences of N = 1e5 down to 0.55 m/s (impacts 1..12). Accept at k = 2, 5, 10 (p > 1e-3);
+  // the same law with the spin-driven scale tau 25% off (a wrong spin accumulation of the size that
+  // matters: a one-component spin has |Omega| smaller by about that much) must be rejected at k = 10.
+  auto b = small(3000);
+  b.stop_speed = 0.55;
+  const auto s = run_bounces(kSphere, b, BounceVariant::random_orientation, 11, 0);
+  ImpactScene sc;
+  sc.asperities = kSphere.asperities, sc.radius = kSphere.radius, sc.asperity_radius = kSphere.asperity_radius;
+  sc.speed = b.speed, sc.beta = b.beta;
+  const auto laws = bounce_residual_laws(sc, 12);
+  for (unsigned k : {2u, 5u, 10u}) {
+    const auto r = residuals_at(s, k, b.beta);
+    ASSERT_GT(r.size(), 2900u);
+    const auto& L = laws[k - 1];
+    const auto ks = ks_one_sample(r, [&](double t) { return L.cdf(t); });
+    EXPECT_GT(ks.p, 1e-3) << "k = " << k << " D = " << ks.D;
+    sc.speed = L.speed;
+    const auto q = impact_law_parameters(sc);
+    for (double f : {0.75, 1.25}) {
+      const auto W = with_tau(L, q.sigma, q.alpha, f * L.tau);
+      const auto bad = ks_one_sample(r, [&](double t) { return W.cdf(t); });
+      if (k == 10) {
+        EXPECT_LT(bad.p, 1e-4) << "tau x " << f << " D = " << bad.D;
+      }
+    }
+  }
+  // Rates at k = 10 against the fitted Eq. 2 of the residual, within 4 Fisher se.
+  auto b2 = b;
+  b2.bootstrap = 0, b2.windows.clear(), b2.impact_numbers = {10};
+  const auto rep = analyse_bounces(s, b2, 11);
+  ASSERT_EQ(rep.groups.size(), 1u);
+  const auto& g = rep.groups[0];
+  ASSERT_TRUE(g.residual_fitted && g.has_theory);
+  EXPECT_LT(std::abs(g.residual_fit.a.value - g.theory_rate_below), 4 * g.residual_fit.a.se);
+  EXPECT_LT(std::abs(g.residual_fit.c.value - g.theory_rate_above), 4 * g.residual_fit.c.se);
+  EXPECT_GT(std::abs(g.residual_fit.a.value - 1.25 * g.theory_rate_below), 4 * g.residual_fit.a.se);
+  // Explicit contacts forget the spin's sign: no correlation of the residual with the speed or with
+  // the previous residual (|r| < 4 se).
+  EXPECT_LT(std::abs(g.speed_residual_correlation.value), 4 * g.speed_residual_correlation.se);
+  EXPECT_LT(std::abs(rep.lag1_correlation.value), 4 * rep.lag1_correlation.se);
+}
+
+TEST(Bounce, SecVPaperProcedureHasTheMarginalButKeepsTheSpinSign) {
+  // The paper's procedure (Eq. 26 with a signed Omega_x, r_y independent) has, impact by impact,
+  // the same residual law as explicit geometry (Omega_x s, s Rayleigh, is Normal(0, S^2 s^2) given s,
+  // as |Omega| r_perp is), but Omega_x keeps its sign between impacts: consecutive residuals
+  // correlate (pi/4 when the spin term dominates) and so do the speed and the current residual.
+  auto b = small(20000);
+  b.stop_speed = 0.55, b.bootstrap = 0, b.windows.clear(), b.impact_numbers = {2, 5, 10};
+  const auto s = run_bounces(kSphere, b, BounceVariant::paper, 12, 0);
+  const auto rep = analyse_bounces(s, b, 12);
+  for (const auto& g : rep.groups) {
+    ASSERT_TRUE(g.has_theory);
+    EXPECT_GT(g.theory_ks.p, 1e-3) << "k = " << g.lo << " D = " << g.theory_ks.D;
+  }
+  EXPECT_GT(rep.groups[2].speed_residual_correlation.value, 0.5);   // k = 10
+  EXPECT_GT(rep.lag1_correlation.value, 0.6);
+  EXPECT_LT(rep.lag1_correlation.value, std::numbers::pi / 4 + 0.02);
+  // The hybrid with the corrected Eq. 28 and a one-component spin fails the same law (power).
+  const auto h = run_bounces(kSphere, b, BounceVariant::paper_corrected28, 12, 0);
+  const auto rh = analyse_bounces(h, b, 12);
+  ImpactScene sc;
+  sc.asperities = kSphere.asperities, sc.radius = kSphere.radius, sc.asperity_radius = kSphere.asperity_radius;
+  sc.speed = b.speed, sc.beta = b.beta;
+  const auto laws = bounce_residual_laws(sc, 10, true);
+  const auto r = residuals_at(h, 10, b.beta);
+  EXPECT_LT(ks_one_sample(r, [&](double t) { return laws[9].cdf(t); }).p, 1e-6);
+  EXPECT_LT(std::abs(rh.lag1_correlation.value), 4 * rh.lag1_correlation.se);
+}
+
+TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
+  // A Gaussian sample of 4000 is not Laplace (KS D ~ 0.03, far beyond the bootstrap's replicates).
+  // B adapts to ceil(1/alpha) so that the floor 1/(1+B) is below alpha: at alpha = 0.01 a requested
+  // B = 19 becomes 100 and the misfit is rejected (p = 1/101). Where the work budget B n <= 2e7 caps
+  // B below that (alpha = 1e-4 needs 10^4 replicates, the budget allows 5000 at n = 4000) the group is
+  // undecided ("cannot decide at this B"), never accepted. A Laplace sample is accepted.
+  auto make = [](bool laplace) {
+    BounceSamples s;
+    s.variant = BounceVariant::paper_corrected28;
+    s.sequences = 4000;
+    const AsymmetricLaplace L{0.95, std::log(2e5), std::log(3e5)};
+    for (std::uint32_t i = 0; i < 4000; ++i) {
+      Stream st(3, Purpose::test, i);
+      const double g = std::sqrt(-2 * std::log(st.uniform())) * std::cos(2 * std::numbers::pi * st.uniform0());
+      s.sequence.push_back(i), s.number.push_back(1), s.speed.push_back(1.0);
+      s.eps.push_back(laplace ? L.sample(st) : 0.95 + 5e-6 * g);
+      s.eps_time.push_back(std::nan("")), s.spin.push_back(0), s.omega_x_after.push_back(0), s.core.push_back(0);
+    }
+    return s;
+  };
+  auto b = small(4000);
+  b.windows.clear(), b.impact_numbers = {1}, b.alpha = 0.01, b.bootstrap = 19;
+  const auto gauss = make(false);
+  auto r = analyse_bounces(gauss, b, 7);
+  ASSERT_EQ(r.groups.size(), 1u);
+  EXPECT_EQ(r.groups[0].gof.bootstrap, 100u);
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::reject) << "p = " << r.groups[0].gof.p;
+  b.alpha = 1e-4;
+  r = analyse_bounces(gauss, b, 7);
+  EXPECT_EQ(r.groups[0].gof.bootstrap, 5000u);
+  EXPECT_NEAR(r.groups[0].gof.p, 1.0 / 5001, 1e-15);
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::undecided);
+  b.alpha = 0.01;
+  r = analyse_bounces(make(true), b, 7);
+  EXPECT_EQ(r.groups[0].gof_verdict, Verdict::accept) << "p = " << r.groups[0].gof.p;
 }
 
 TEST(Bounce, ValidationNamesTheField) {

@@ -51,6 +51,8 @@ TEST(Laplace, FitRecoversParametersWithinStatedErrors) {
   EXPECT_LT(std::abs(f.m.value - law.m), 4 * f.m.se);
   EXPECT_LT(std::abs(f.log_a.value - law.log_a), 4 * f.log_a.se);
   EXPECT_LT(std::abs(f.log_c.value - law.log_c), 4 * f.log_c.se);
+  // A rate 10 % off is outside the same 4 se (se(log a) ~ 0.013 here).
+  EXPECT_GT(std::abs(f.log_a.value - (law.log_a + std::log(1.1))), 4 * f.log_a.se);
   EXPECT_GT(f.log_a.se, 0.005);
   EXPECT_LT(f.log_a.se, 0.05);
   EXPECT_NEAR(f.a.se / f.a.value, f.log_a.se, 1e-15);
@@ -61,17 +63,20 @@ TEST(Laplace, ConfidenceIntervalsCover) {
   // 0.95 +- 3 binomial sd (sd = 0.011). A wrong se (e.g. half) would give ~0.68 and fail.
   const auto law = truth();
   const int reps = 400;
-  int cov_m = 0, cov_a = 0, cov_c = 0;
+  int cov_m = 0, cov_a = 0, cov_c = 0, wrong_a = 0;
   for (int r = 0; r < reps; ++r) {
     const auto f = fit_asymmetric_laplace(draw(law, 1000, 100 + r));
     cov_m += std::abs(f.m.value - law.m) < 1.96 * f.m.se;
     cov_a += std::abs(f.log_a.value - law.log_a) < 1.96 * f.log_a.se;
     cov_c += std::abs(f.log_c.value - law.log_c) < 1.96 * f.log_c.se;
+    // A se 25 % too small (the size that matters: e.g. a missing factor in the Fisher information).
+    wrong_a += std::abs(f.log_a.value - law.log_a) < 1.96 * 0.75 * f.log_a.se;
   }
   for (int c : {cov_m, cov_a, cov_c}) {
     EXPECT_GT(c / double(reps), 0.95 - 0.033) << c;
     EXPECT_LT(c / double(reps), 0.95 + 0.033) << c;
   }
+  EXPECT_LT(wrong_a / double(reps), 0.95 - 0.033) << wrong_a;  // ~0.86 expected
 }
 
 TEST(Laplace, ProfileLikelihoodIsTheMaximum) {
@@ -125,6 +130,22 @@ TEST(Laplace, GoodnessOfFitAcceptsLaplaceAndRejectsOthers) {
     const auto gy = laplace_gof(*y, fit_asymmetric_laplace_sorted(*y), 99, 1, 1);
     EXPECT_LE(gy.p, 0.02) << gy.D;
   }
+}
+
+TEST(Laplace, BootstrapIsCalibratedUnderTheNull) {
+  // The replicates are drawn already sorted (Renyi spacings through the quantile, O(n)). Under H0
+  // the bootstrap p is uniform on {1/20, ..., 1} at B = 19: over 300 ALD samples of n = 400,
+  // P(p <= 0.1) = 0.1 within 4 sd (a sorted sampler with the wrong law or a broken tail would shift
+  // D_b against D and this fraction with it). The power side is the test above (Gaussian, uniform).
+  const auto law = truth();
+  int low = 0;
+  for (int r = 0; r < 300; ++r) {
+    auto x = draw(law, 400, 1000 + r);
+    std::sort(x.begin(), x.end());
+    low += laplace_gof(x, fit_asymmetric_laplace_sorted(x), 19, 7, r).p <= 0.1 + 1e-12 ? 1 : 0;
+  }
+  const double sd = std::sqrt(300 * 0.1 * 0.9);
+  EXPECT_LT(std::abs(low - 30), 4 * sd) << low;
 }
 
 TEST(Laplace, BootstrapIndependentOfThreads) {

@@ -73,6 +73,17 @@ TEST(TheoryRadii, FreshSamplerEqualsExplicitBodies) {
   std::sort(fr.begin(), fr.end());
   EXPECT_GT(ks_two_sample(ex, fr).p, 0.01);
   EXPECT_GT(ks_one_sample(ex, levels_sphere_rxy(N, R, kTwo).cdf).p, 0.01);
+  // Power at this size: a sampler with the wrong density (N x 1.5, r_xy 18% smaller: what a
+  // mistaken area or count would do) must be told apart from the explicit bodies by the same
+  // two-sample test; so must the law for that N by the one-sample test.
+  std::vector<double> wrong(K);
+  for (std::uint64_t k = 0; k < K; ++k) {
+    const Vec3 r = fresh_levels_contact(N * 3 / 2, R, kTwo, 6, k).r;
+    wrong[k] = std::hypot(r.x(), r.y());
+  }
+  std::sort(wrong.begin(), wrong.end());
+  EXPECT_LT(ks_two_sample(ex, wrong).p, 0.01);
+  EXPECT_LT(ks_one_sample(ex, levels_sphere_rxy(N * 3 / 2, R, kTwo).cdf).p, 0.01);
 }
 
 TEST(TheoryRadii, BadInputIsRefused) {

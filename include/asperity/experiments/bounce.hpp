@@ -4,13 +4,20 @@
 // collected, grouped, and fitted with the asymmetric Laplace law of Eq. 2 (laplace.hpp).
 //
 // Variants (selectable, reported side by side):
-//  - paper: eps drawn from the corrected Eq. 28 in its generative form eps = eps_n + b^2/(4 alpha)
-//    - alpha W (W/sigma^2 noncentral chi-square, theory_impact.hpp) at the current speed and spin,
-//    Omega'_x from the corrected Eq. 33, drawn independently as the paper does; the next impact
-//    speed is eps times this one (flight conserves |V_z|). Only Omega_x is tracked, as in the paper.
-//  - paper-printed33: the same with Omega'_x from Eq. 33 as printed (6x wider). Eq. 28 as printed
-//    is not a density (negative, or normalised a point mass; docs/sec4-derivations.md) and
-//    cannot be iterated; its corrected form is used in both paper variants.
+//  - paper: the paper's Sec. V procedure. eps from Eq. 28 along the paper's own route, i.e. with its
+//    approximations (Eq. 26: r_x + r_y ~ r_xy Rayleigh, times the tracked, signed Omega_x; r_z = R + a)
+//    and the algebra repaired so that it is a density (eq28-paper-route, theory_impact.hpp): s ~
+//    Rayleigh(sigma), eps = eq28_paper_route_eps(s). Then Omega'_x = Omega_x + (1 + eps) u r_y/(I + r_z^2),
+//    r_y ~ Normal(0, sigma^2) drawn independently of s (Eq. 32 with the sign and J corrected; P_z =
+//    M u (1 + eps) with the eps just drawn; equivalently the corrected Eq. 33), as the paper's Fig. 5
+//    drew r_y and eps independently. Only Omega_x is tracked and it keeps its sign between impacts.
+//    The next impact speed is eps times this one (flight conserves |V_z|).
+//  - paper-printed33: the same with Omega'_x ~ Normal(Omega_x, sigma_printed^2), Eq. 33 as printed
+//    (6x wider). Eq. 28 as printed is not a density (docs/sec4-derivations.md) and cannot be iterated.
+//  - paper-corrected28: the paper's iteration with eps from the corrected Eq. 28 (noncentral chi^2 in
+//    |Omega_x|, no Eq. 26) and Omega'_x from the corrected Eq. 33 drawn independently; only Omega_x
+//    tracked. It isolates what Eq. 26 does inside the paper's procedure (paper vs paper-corrected28)
+//    and what a one-component spin does (paper-corrected28 vs random-orientation).
 //  - random-orientation: explicit geometry and the full impulse (impact.hpp) at every impact, on
 //    one lazy exact sphere per sequence (lazy_sphere.hpp) given a fresh Haar orientation before
 //    every impact: consecutive contacts are independent, as the paper assumes.
@@ -29,6 +36,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -37,12 +45,13 @@
 #include "asperity/core/geometry.hpp"
 #include "asperity/laws/laplace.hpp"
 #include "asperity/laws/statistics.hpp"
+#include "asperity/laws/verdict.hpp"
 
 namespace asperity {
 
-enum class BounceVariant { paper, paper_printed33, random_orientation, dynamic };
+enum class BounceVariant { paper, paper_printed33, random_orientation, dynamic, paper_corrected28 };
 std::string_view to_string(BounceVariant v);
-/// "paper", "paper-printed33", "random-orientation", "dynamic"; throws std::invalid_argument naming the value.
+/// "paper", "paper-printed33", "random-orientation", "dynamic", "paper-corrected28"; throws std::invalid_argument naming the value.
 BounceVariant parse_bounce_variant(std::string_view s);
 
 struct BounceExperiment {
@@ -61,7 +70,11 @@ struct BounceExperiment {
   unsigned max_impacts = 100000;  ///< safety bound per sequence
   std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
                                   ///< max(19, 2e7/n): the work is B n; the count used is reported)
-  /// Impact-speed windows [lo, hi] [m/s] (the unbiased grouping, see BounceReport::grouping_note).
+  /// Level of the goodness-of-fit verdicts: a group whose bootstrap found no replicate as far from
+  /// its fit as the data (p at its floor 1/(1+B)) while 1/(1+B) >= alpha is undecided.
+  double alpha = 0.01;
+  /// Impact-speed windows [lo, hi] [m/s]: p(eps | u) with the history marginalised as the experiment
+  /// does; membership depends on the past (u_k = u_1 prod eps_j), see bounce_grouping_note().
   std::vector<std::pair<double, double>> windows{{0.9, 1.0}, {0.7, 0.8}, {0.5, 0.6}, {0.3, 0.4}, {0.1, 0.2}};
   /// Impact numbers k (1 = first impact) grouped for comparison.
   std::vector<unsigned> impact_numbers{1, 2, 5, 10, 20, 40};
@@ -75,6 +88,8 @@ void validate(const BounceExperiment& b);
 /// Every impact of every sequence, sequence by sequence, in impact order.
 struct BounceSamples {
   BounceVariant variant = BounceVariant::dynamic;
+  std::optional<SphereParams> sphere;   ///< set by run_bounces (enables the semi-analytic residual law)
+  double first_speed = 0;               ///< u_1 [m/s]
   std::uint64_t sequences = 0;
   std::vector<std::uint32_t> sequence;  ///< sequence index
   std::vector<std::uint32_t> number;    ///< impact number k = 1, 2, ...
@@ -123,6 +138,22 @@ struct BounceGroup {
   bool fitted = false;         ///< n >= 20
   LaplaceFit fit;
   LaplaceGof gof;
+  /// accept, reject (p < alpha) or undecided ("cannot decide at this B": no replicate reached D and
+  /// the floor 1/(1+B) is not below alpha); skipped without a bootstrap.
+  Verdict gof_verdict = Verdict::skipped;
+  /// The residual eps - eps_n(u_k) of every group (for speed windows the same as `quantity`):
+  /// mean, sd, Eq. 2 fit (no bootstrap) and its correlation with the impact speed u_k (se 1/sqrt(n)).
+  Estimate residual_mean;
+  double residual_std = 0;
+  bool residual_fitted = false;
+  LaplaceFit residual_fit;
+  Estimate speed_residual_correlation;
+  /// Semi-analytic law of the residual (theory_impact.hpp bounce_residual_laws; for a speed window the
+  /// mixture over the impact numbers it holds, weighted by their counts): KS of the residual against
+  /// it, and for impact groups its rates. Spheres only (has_theory).
+  bool has_theory = false;
+  KsResult theory_ks;
+  double theory_rate_below = 0, theory_rate_above = 0;
   std::vector<double> sorted;  ///< the group's `quantity`, sorted (for figures; not serialised)
 };
 
@@ -163,7 +194,7 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
 std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& sphere, const BounceExperiment& b,
                                                        std::uint64_t seed, int threads = 0, std::ostream* log = nullptr);
 
-/// Why speed windows, not impact numbers, give the unbiased p(eps | u).
+/// Which grouping answers which question, and when window selection by the past biases it.
 std::string bounce_grouping_note();
 
 

@@ -28,6 +28,7 @@
 // and its description states the raw integral.
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "asperity/core/restitution.hpp"
 #include "asperity/laws/theory.hpp"
@@ -43,6 +44,10 @@ struct ImpactScene {
   double omega_y = 0.0;               ///< [rad/s]
   double beta = 0.0467;               ///< Pade [1/4] material constant [(s/m)^(1/5)]
   bool core_contacts = false;         ///< corrected laws only: include bare-sphere contacts (atom of mass p0)
+  /// Eq. 23 read literally: J = (2/5) M rho^2 with rho the ASPERITY radius, I_g = (2/5) a^2 (the
+  /// default, and the code's physics, is the central sphere's J = (2/5) M R^2; the asperities add
+  /// ~N (a/R)^3 to it). For the README's table and a test that explicit geometry rejects it.
+  bool literal_eq23 = false;
 };
 
 /// Throws std::invalid_argument naming the field: N >= 1, R > 0, 0 <= a < R, u > 0, beta > 0,
@@ -85,5 +90,42 @@ struct ImpactLawParameters {
   double p_core = 0;     ///< exp(-r*^2/(2 sigma^2)): probability of a core contact (flat cap)
 };
 ImpactLawParameters impact_law_parameters(const ImpactScene& s);
+
+/// The map of eq28_paper_route for generative use: eps at r_xy = s [m], impact speed u [m/s] and
+/// spin Omega_x [rad/s] (paper frame, as given), with eps_n and c^2 from `p` (the scene at speed u):
+///   eps = eps_n + (1 + eps_n) s (Omega_x c^2 - u s) / (u (s^2 + c^2)),
+/// i.e. -1 + Q (u + Omega_x s)/(u (s^2 + c^2)) written without cancellation. With s ~ Rayleigh(sigma)
+/// it draws from eq28-paper-route (both preimages included by construction: Eq. 28 repaired).
+double eq28_paper_route_eps(const ImpactLawParameters& p, double u, double omega_x, double s);
+
+/// Semi-analytic law of the residual eps - eps_n(u_k) at impact k of a sequence dropped at speed
+/// s.speed without spin, for explicit geometry with independent contacts (derivation:
+/// docs/sec4-derivations.md Sec. 11). The spin before impact k is the sum of the kicks
+/// -K_j (r_y, -r_x) of impacts j < k, a planar Gaussian with per-component variance
+/// S_k^2 = sum_j sigma_c(u_j)^2 (speeds u_{j+1} = u_j (eps_n(u_j) - 2 alpha_j sigma^2), deterministic
+/// to ~1e-4). The corrected Eq. 28 gives residual = -alpha (|r|^2 + 2 r.D), D = beta1 Omega/(2 alpha)
+/// (rotated by 90 degrees) ~ planar Normal(0, tau^2), tau = beta1 S_k/(2 alpha), independent of r ~
+/// planar Normal(0, sigma^2). The quadratic form |r|^2 + 2 r.D has eigenvalues
+/// lambda_+- = (sigma^2 +- sqrt(sigma^4 + 4 sigma^2 tau^2))/2, each twice, so
+///   residual = a2 E2 - a1 E1,  a1 = 2 alpha lambda_+,  a2 = -2 alpha lambda_-,  E1, E2 ~ Exp(1):
+/// exactly the asymmetric Laplace law of Eq. 2 with mode eps_n(u_k), left rate 1/a1, right rate 1/a2
+/// (one-sided at k = 1, a2 = 0). Mean -2 alpha sigma^2 at every k.
+/// The paper's procedure (Eq. 26 with a signed Omega_x, r_y drawn independently) has, impact by
+/// impact, the same marginal with beta1 -> (1 + eps_n)/u: Omega_x s, s ~ Rayleigh, Omega_x ~
+/// Normal(0, S_k^2) given s is Normal(0, S_k^2 s^2), as |Omega| r_perp is. `paper_route` selects that.
+struct BounceResidualLaw {
+  unsigned k = 1;
+  double speed = 0;    ///< u_k [m/s]
+  double eps_n = 0;    ///< eps_n(u_k)
+  double spin_sd = 0;  ///< S_k [rad/s]
+  double tau = 0;      ///< [m]
+  double a1 = 0, a2 = 0;  ///< scales below / above the mode [1]
+  double rate_below() const { return 1.0 / a1; }
+  double rate_above() const { return a2 > 0 ? 1.0 / a2 : 1.0 / 0.0; }
+  double cdf(double t) const;  ///< of the residual
+  double mean() const { return a2 - a1; }
+};
+/// Laws for k = 1 ... k_max (index k - 1).
+std::vector<BounceResidualLaw> bounce_residual_laws(const ImpactScene& s, unsigned k_max, bool paper_route = false);
 
 }  // namespace asperity

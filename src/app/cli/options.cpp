@@ -157,7 +157,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   app.add_option("--omega-x", omega_x, "impact: spin Omega_x before [rad/s]");
   app.add_option("--omega-y", omega_y, "impact: spin Omega_y before [rad/s]");
   std::string variants, sequences;
-  app.add_option("--variant", variants, "bounce runs (fig6): comma list of paper, paper-printed33, random-orientation, dynamic");
+  app.add_option("--variant", variants, "bounce runs (fig6): comma list of paper, paper-printed33, paper-corrected28, random-orientation, dynamic");
   app.add_option("--sequences", sequences, "bounce runs (fig6): bounce sequences per variant");
   app.add_flag("--no-plots", no_plots, "do not write PNG figures");
   app.add_flag("--quiet,-q", quiet, "print no progress");
