@@ -39,9 +39,13 @@ double per_asperity(Backend b) {
 constexpr double kPerDropFresh = 49;      // contact samples per drop
 constexpr double kPerDropFixed = 57;      // + the rotation
 constexpr double kPerDropImpact = 92;     // + eps, Omega' (fresh or fixed)
-constexpr double kPerAsperityMesh = 108;  // a mesh body's asperity: centre, radius, support tree
+constexpr double kPerAsperityMesh = 160;  // a mesh body's asperity: centre, radius, support tree, and the
+                                          // heap validate-geometry keeps between bodies (mallopt)
 constexpr double kPerDropMesh = 68;
 constexpr double kPerImpactBounce = 64;   // one impact of a bounce sequence, kept for the analysis
+// The paper's procedure (paper, paper-printed33, paper-corrected28) holds ~6x more per impact
+// (measured: 178 MB at 8000 sequences x 55.5 impacts, 45 MB at 2000).
+constexpr double kPerImpactBouncePaper = 380;
 constexpr double kImpactsPerDecade = 55.5;  // fig6: 55.5 impacts from 1 m/s down to 0.1 m/s
 
 int threads_of(const Scene& s) {
@@ -85,7 +89,10 @@ MemoryEstimate estimate_memory(const Scene& s) {
         const double concurrent =
             pe.spheres <= 1 ? 1.0 : double(std::min<std::uint64_t>(std::uint64_t(threads_of(s)), pe.spheres));
         const double b = per_asperity(pe.backend);
-        m.bytes += concurrent * N * b;
+        // + the kd-tree of the cross-check (one checked sphere at a time, measured when spheres run
+        // in parallel), unless it is the backend.
+        const double check = pe.spheres <= 1 || pe.backend == Backend::kdtree ? 0.0 : per_asperity(Backend::kdtree);
+        m.bytes += concurrent * N * b + N * check;
         d << " + " << fmt(concurrent) << " sphere(s) at once (--threads " << threads_of(s) << ") x " << count(e.sphere.asperities)
           << " asperities x " << b << " B (" << to_string(pe.backend) << ")";
       }
@@ -118,8 +125,11 @@ MemoryEstimate estimate_memory(const Scene& s) {
       const double impacts = kImpactsPerDecade * std::log10(s.bounce.speed / s.bounce.stop_speed);
       const double seq = double(s.bounce.sequences);
       const double variants = 1.0 + (double(s.bounce.variants.size()) - 1.0) / 6.0;
-      m.bytes = kBaseSphere + seq * impacts * kPerImpactBounce * variants;
-      d << count(s.bounce.sequences) << " sequences x ~" << fmt(impacts) << " impacts x " << kPerImpactBounce << " B x " << fmt(variants)
+      double per_impact = kPerImpactBounce;
+      for (BounceVariant v : s.bounce.variants)
+        if (to_string(v).starts_with("paper")) per_impact = kPerImpactBouncePaper;
+      m.bytes = kBaseSphere + seq * impacts * per_impact * variants;
+      d << count(s.bounce.sequences) << " sequences x ~" << fmt(impacts) << " impacts x " << per_impact << " B x " << fmt(variants)
         << " (variants)";
       break;
     }

@@ -208,7 +208,10 @@ TEST(CliOutput, AGnuplotFailureOnTheSecondFigureKeepsThePreviousRun) {
                   out.string() + " 2>&1");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("fake gnuplot: failing"), std::string::npos) << r.out;
-  EXPECT_EQ(slurp(bin / "count"), "3\n");
+  // Figures render concurrently (issue 13), so which figure the fake fails on and its counter
+  // (read-then-write, racy between concurrent calls) vary; what must hold: gnuplot ran more than
+  // once, the run failed naming gnuplot's error, and the previous run's files are untouched.
+  EXPECT_NE(slurp(bin / "count"), "1\n");
   EXPECT_TRUE(snapshot(out) == before) << "the previous figures changed";
   fs::remove_all(out);
   fs::remove_all(bin);
