@@ -24,7 +24,6 @@ namespace {
 // -f %M on runs of 1e6..4e6 asperities or drops; slope between two sizes):
 constexpr double kBaseSphere = 10.6e6;   // the process with its libraries, sphere runs
 constexpr double kBaseMesh = 19.5e6;     // mesh runs (mesh, CGAL support tree code)
-constexpr double kCentre = 24;           // one asperity centre (3 doubles)
 // Per asperity of one explicit sphere, centre included, by contact index.
 double per_asperity(Backend b) {
   switch (b) {
