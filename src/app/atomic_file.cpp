@@ -24,8 +24,9 @@ namespace {
 void write_file_atomic(const std::filesystem::path& file, const std::string& text) {
   auto tmp = file;
   tmp += ".tmp." + std::to_string(::getpid());
-  const InterruptCleanup on_signal(tmp, InterruptCleanup::Kind::file);
+  InterruptCleanup on_signal(tmp, InterruptCleanup::Kind::file);
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  on_signal.created();
   if (fd < 0) fail(file, errno, tmp);
   const char* p = text.data();
   std::size_t left = text.size();

@@ -18,14 +18,25 @@ namespace {
 
 constexpr int kSlots = 64;
 
+// Slot states. A registered path or child may still be being created by its thread ("creating"):
+// the handler waits for that to end, since a path created after the handler looked would stay.
+constexpr int kFree = 0, kRegistered = 1, kWriting = 2, kCreating = 3;
+
 struct Slot {
-  std::atomic<int> state{0};  // 0 free, 2 being written, 1 registered
+  std::atomic<int> state{kFree};
+  std::atomic<long> creator{0};  // the thread creating it (the handler does not wait for itself)
   InterruptCleanup::Kind kind = InterruptCleanup::Kind::directory;
   char path[PATH_MAX] = {};
 };
 
+struct ChildSlot {
+  std::atomic<int> state{kFree};
+  std::atomic<long> creator{0};
+  std::atomic<pid_t> pgid{0};
+};
+
 Slot g_slots[kSlots];
-std::atomic<pid_t> g_child{0};
+ChildSlot g_children[kSlots];  // figures render concurrently: one gnuplot per thread
 std::atomic<int> g_phase{0};    // 0 running, 1 deferred (renaming into place), 2 aborting
 std::atomic<int> g_pending{0};  // a signal that arrived while deferred
 std::atomic<bool> g_installed{false};
@@ -59,7 +70,7 @@ const char* signal_name(int sig) {
 // (getdents64, unlinkat, rmdir: async-signal-safe). A file created meanwhile by another thread is
 // caught by the next pass.
 void wipe_dir(const char* path) {
-  for (int pass = 0; pass < 4; ++pass) {
+  for (int pass = 0; pass < 1000; ++pass) {  // ends once nothing is created inside any more
     const int fd = ::open(path, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
     if (fd < 0) return;
     alignas(8) char buf[4096];
@@ -81,23 +92,44 @@ void wipe_dir(const char* path) {
   }
 }
 
+long this_thread_id() { return ::syscall(SYS_gettid); }
+
+// Waits (at most ~2 s in all, nanosleep is async-signal-safe) until no other thread is between
+// registering a slot and having created its path or child. The thread running the handler is
+// not waited for: it creates nothing more.
+template <class Slots>
+void wait_for_creations(Slots& slots, long self, int& budget_ms) {
+  for (auto& s : slots)
+    while (s.state.load() == kCreating && s.creator.load() != self && budget_ms > 0) {
+      const timespec ms{0, 1000000};
+      ::nanosleep(&ms, nullptr);
+      --budget_ms;
+    }
+}
+
+bool live(const Slot& s) { return s.state.load() == kRegistered || s.state.load() == kCreating; }
+
 [[noreturn]] void clean_up_and_exit(int sig) {
-  const pid_t child = g_child.load();
-  if (child > 0) {
+  const long self = this_thread_id();
+  int budget_ms = 2000;
+  wait_for_creations(g_children, self, budget_ms);
+  for (auto& c : g_children) {
+    const pid_t child = c.pgid.load();
+    if (c.state.load() != kRegistered || child <= 0) continue;
     ::kill(-child, SIGKILL);
     ::waitpid(child, nullptr, 0);  // may find it reaped already (ECHILD): it is gone either way
   }
+  wait_for_creations(g_slots, self, budget_ms);
   using Kind = InterruptCleanup::Kind;
   for (auto& s : g_slots)
-    if (s.state.load() == 1 && s.kind == Kind::file) ::unlink(s.path);
+    if (live(s) && s.kind == Kind::file) ::unlink(s.path);
   for (auto& s : g_slots)
-    if (s.state.load() == 1 && s.kind == Kind::directory) wipe_dir(s.path);
+    if (live(s) && s.kind == Kind::directory) wipe_dir(s.path);
   // Directories the run created for its output, deepest first: registered parent first, so
   // backwards; removed only when empty.
-  for (int i = kSlots - 1; i >= 0; --i)
-    if (g_slots[i].state.load() == 1 && g_slots[i].kind == Kind::empty_directory) ::rmdir(g_slots[i].path);
-  for (int i = kSlots - 1; i >= 0; --i)
-    if (g_slots[i].state.load() == 1 && g_slots[i].kind == Kind::empty_directory) ::rmdir(g_slots[i].path);
+  for (int pass = 0; pass < 2; ++pass)
+    for (int i = kSlots - 1; i >= 0; --i)
+      if (live(g_slots[i]) && g_slots[i].kind == Kind::empty_directory) ::rmdir(g_slots[i].path);
   put(g_program);
   put(": interrupted by ");
   put(signal_name(sig));
@@ -150,26 +182,52 @@ InterruptCleanup::InterruptCleanup(const std::filesystem::path& path, Kind kind)
   if (p.empty() || p.size() >= PATH_MAX) return;
   if (g_phase.load() == 2) wait_for_exit();
   for (int i = 0; i < kSlots; ++i) {
-    int expected = 0;
-    if (!g_slots[i].state.compare_exchange_strong(expected, 2)) continue;
+    int expected = kFree;
+    if (!g_slots[i].state.compare_exchange_strong(expected, kWriting)) continue;
     std::memcpy(g_slots[i].path, p.c_str(), p.size() + 1);
     g_slots[i].kind = kind;
-    g_slots[i].state.store(1);
+    g_slots[i].creator.store(this_thread_id());
+    g_slots[i].state.store(kCreating);
     slot_ = i;
     break;
   }
   // A handler that started before the slot was visible did not see it: do not create the
-  // directory, wait for the handler to end the process.
+  // path, wait for the handler to end the process.
   if (g_phase.load() == 2) wait_for_exit();
 }
 
-InterruptCleanup::~InterruptCleanup() {
-  if (slot_ >= 0) g_slots[slot_].state.store(0);
+void InterruptCleanup::created() {
+  if (slot_ >= 0) g_slots[slot_].state.store(kRegistered);
 }
 
-void set_interrupt_child(pid_t pgid) { g_child.store(pgid); }
+InterruptCleanup::~InterruptCleanup() {
+  if (slot_ >= 0) g_slots[slot_].state.store(kFree);
+}
+
+InterruptChild::InterruptChild() {
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = kFree;
+    if (!g_children[i].state.compare_exchange_strong(expected, kWriting)) continue;
+    g_children[i].pgid.store(0);
+    g_children[i].creator.store(this_thread_id());
+    g_children[i].state.store(kCreating);
+    slot_ = i;
+    break;
+  }
+  if (g_phase.load() == 2) wait_for_exit();  // as for paths: spawn nothing the handler missed
+}
+
+void InterruptChild::started(pid_t pgid) {
+  if (slot_ < 0) return;
+  g_children[slot_].pgid.store(pgid);
+  g_children[slot_].state.store(kRegistered);
+}
+
+InterruptChild::~InterruptChild() {
+  if (slot_ >= 0) g_children[slot_].state.store(kFree);
+}
+
 void set_interrupt_output_committed() { g_committed.store(true); }
-void clear_interrupt_child() { g_child.store(0); }
 
 InterruptDeferral::InterruptDeferral() {
   int expected = 0;

@@ -59,9 +59,14 @@ OutputStaging::OutputStaging(const fs::path& out) : out_(out) {
   std::reverse(missing.begin(), missing.end());
   for (const auto& d : missing) {
     guards_.push_back(std::make_unique<InterruptCleanup>(d, InterruptCleanup::Kind::empty_directory));
-    if (::mkdir(d.c_str(), 0777) != 0 && errno != EEXIST) {
-      const int err = errno;
+    const int rc = ::mkdir(d.c_str(), 0777);
+    const int err = errno;
+    guards_.back()->created();
+    if (rc != 0 && err != EEXIST)
       throw std::runtime_error("cannot create directory '" + d.string() + "': " + reason(err));
+    if (rc != 0) {  // someone else created it meanwhile: not ours to remove
+      guards_.pop_back();
+      continue;
     }
     created_.push_back(d);
   }
@@ -73,8 +78,10 @@ OutputStaging::OutputStaging(const fs::path& out) : out_(out) {
   if (!S_ISDIR(st.st_mode)) throw std::runtime_error("'" + out.string() + "' is not a directory");
   dir_ = out / (std::string(kStagingPrefix) + random_suffix());
   guards_.push_back(std::make_unique<InterruptCleanup>(dir_));
-  if (::mkdir(dir_.c_str(), 0700) != 0) {
-    const int err = errno;
+  const int rc = ::mkdir(dir_.c_str(), 0700);
+  const int err = errno;
+  guards_.back()->created();
+  if (rc != 0) {
     throw std::runtime_error("cannot write into directory '" + out.string() + "': " + reason(err));
   }
 }

@@ -95,6 +95,7 @@ bool run_gnuplot_process(const std::vector<std::string>& args, const fs::path& e
   for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
   pid_t pid = 0;
+  InterruptChild on_signal;
   const int rc = posix_spawnp(&pid, argv[0], &fa, &at, argv.data(), environ);
   posix_spawn_file_actions_destroy(&fa);
   posix_spawnattr_destroy(&at);
@@ -102,13 +103,12 @@ bool run_gnuplot_process(const std::vector<std::string>& args, const fs::path& e
     if (spawn_error) *spawn_error = rc;
     return false;
   }
-  set_interrupt_child(pid);
+  on_signal.started(pid);
   int status = 0;
   pid_t w;
   do {
     w = ::waitpid(pid, &status, 0);
   } while (w == -1 && errno == EINTR);
-  clear_interrupt_child();
   return w == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
@@ -352,15 +352,18 @@ void run_gnuplot(const char* who, const fs::path& png, const std::function<std::
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
   if (stem.size() > 64) stem.resize(64);
   const fs::path work = tmp_root / ("asperity-plot-" + stem + "-" + suffix);
-  const InterruptCleanup work_on_signal(work);  // registered before it exists
-  if (!fs::create_directory(work, ec) || ec)
+  InterruptCleanup work_on_signal(work);  // registered before it exists
+  const bool made = fs::create_directory(work, ec);
+  work_on_signal.created();
+  if (!made || ec)
     throw std::runtime_error(w + ": cannot create " + work.string() +
                              (ec ? ": " + ec.message() : std::string(": already exists")));
   cleanup.paths.push_back(work);
 
   // Gnuplot renders beside the target so the final rename is atomic (same filesystem).
   const fs::path out = png.parent_path() / (png.filename().string() + "." + suffix + ".tmp");
-  const InterruptCleanup out_on_signal(out, InterruptCleanup::Kind::file);
+  InterruptCleanup out_on_signal(out, InterruptCleanup::Kind::file);
+  out_on_signal.created();  // gnuplot creates it: the handler kills gnuplot before removing it
   cleanup.paths.push_back(out);
 
   const fs::path script = work / "figure.gp";

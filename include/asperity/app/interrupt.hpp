@@ -15,7 +15,9 @@ namespace asperity {
 /// written to stderr on a signal ("<program>: interrupted by SIGINT; ...").
 void install_interrupt_cleanup(const char* program);
 
-/// A path removed on a signal while the guard lives. Register it BEFORE creating it.
+/// A path removed on a signal while the guard lives. Register it BEFORE creating it and call
+/// created() once the attempt to create it returned (success or not): a handler that starts in
+/// between waits for created() (up to 2 s), so nothing is created after it cleaned up.
 class InterruptCleanup {
  public:
   enum class Kind {
@@ -25,6 +27,7 @@ class InterruptCleanup {
   };
   explicit InterruptCleanup(const std::filesystem::path& path, Kind kind = Kind::directory);
   ~InterruptCleanup();
+  void created();
   InterruptCleanup(const InterruptCleanup&) = delete;
   InterruptCleanup& operator=(const InterruptCleanup&) = delete;
 
@@ -32,9 +35,20 @@ class InterruptCleanup {
   int slot_ = -1;  ///< -1: no free slot (too many at once): not cleaned on a signal
 };
 
-/// The process group of a running child (gnuplot in its own group): killed on a signal.
-void set_interrupt_child(pid_t pgid);
-void clear_interrupt_child();
+/// A child process (gnuplot, in its own process group) killed on a signal while the guard lives.
+/// Construct it BEFORE spawning and call started(pgid) after (not at all if the spawn failed): a
+/// handler that starts in between waits for it (up to 2 s). Several may live at once.
+class InterruptChild {
+ public:
+  InterruptChild();
+  ~InterruptChild();
+  void started(pid_t pgid);
+  InterruptChild(const InterruptChild&) = delete;
+  InterruptChild& operator=(const InterruptChild&) = delete;
+
+ private:
+  int slot_ = -1;
+};
 
 /// The run's files are in place (OutputStaging::commit): a later signal says so.
 void set_interrupt_output_committed();
