@@ -59,6 +59,14 @@ CorTableSpec cor_table_spec(const Scene& s, std::size_t speeds) {
   return c;
 }
 
+CorTableSpec cor_table_spec(const Scene& s, const CorTableScene& c) {
+  CorTableSpec spec = cor_table_spec(s);
+  if (!c.speeds.empty()) spec.speeds = c.speeds;
+  spec.probabilities = c.probabilities;
+  spec.drops = c.drops;
+  return spec;
+}
+
 void validate(const CorTableSpec& c) {
   validate(c.sphere);
   if (c.speeds.empty()) bad("speeds", "[]", "needs at least one speed");
@@ -157,7 +165,7 @@ std::string cor_table_json(const CorTable& t) {
                    {"restitution", {{"model", "viscoelastic"}, {"beta", s.impact.beta}}}};
   j["Omega_rad_s"] = {s.impact.omega.x(), s.impact.omega.y(), s.impact.omega.z()};
   j["ensemble"] = {{"mode", "sampled"},
-                   {"method", "sampled from the exact finite-N law of the lowest asperity (no sphere is built)"},
+                   {"method", kCorTableEnsemble},
                    {"drops_per_speed", s.drops}, {"seed", s.seed}};
   j["speeds_m_s"] = s.speeds;
   j["probabilities"] = t.probabilities;

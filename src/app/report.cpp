@@ -583,6 +583,7 @@ std::string with_header(const std::string& body, const ReportHeader& h) {
   if (!h.scene_toml.empty()) j["scene_file"] = h.scene_toml;
   if (!h.plan.empty()) j["plan"] = plan_json(h.plan);
   if (!h.timings_s.empty()) j["timings_s"] = timings_json(h.timings_s);
+  for (const auto& [name, text] : h.sections) j[name] = json::parse(text);
   return j.dump(2) + "\n";
 }
 

@@ -246,6 +246,28 @@ class Reader {
 
 constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
 
+// [outputs.cor_table]: file (required), speeds, probabilities, drops. The names are checked against
+// the run's other outputs by validate(Scene); the table's own ranges here, each key named.
+CorTableScene read_cor_table(Reader& t) {
+  CorTableScene c;
+  const auto file = t.text("file");
+  if (!file) t.missing("file", "the table's CSV file name inside outputs.dir, e.g. \"cor.csv\"");
+  c.file = *file;
+  if (auto v = t.reals("speeds")) {
+    for (std::size_t i = 0; i < v->size(); ++i) {
+      const double u = (*v)[i];
+      if (!(u > 0) || u > 1e8) t.bad("speeds", "each speed must be > 0 and <= 1e8 m/s, got " + num(u));
+      if (i > 0 && !(u > (*v)[i - 1])) t.bad("speeds", "must ascend strictly, got " + num((*v)[i - 1]) + " then " + num(u));
+    }
+    if (v->size() > 1000) t.bad("speeds", "at most 1000 speeds, got " + std::to_string(v->size()));
+    c.speeds = *v;
+  }
+  if (auto p = t.count("probabilities", 2, 100001)) c.probabilities = *p;
+  if (auto d = t.count("drops", 3, kMaxDrops)) c.drops = *d;
+  t.finish();
+  return c;
+}
+
 // THE mapping from a scene file to a Scene: every section and key of format 1 is read here, and
 // nowhere else. New engine features (mesh bodies, radius distributions, bounce experiments, ...)
 // are wired in by replacing the matching `unsupported(...)` with a field of Scene.
@@ -645,6 +667,12 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     }
     if (s.mesh && !(s.contact_stats && s.restitution_stats))
       out->bad(s.contact_stats ? "restitution" : "contact", "a mesh body's run always analyses contacts and restitution");
+    if (auto ct = out->table("cor_table")) {
+      if (s.mesh || s.radii || s.bounce.enabled || !impacts)
+        out->bad("cor_table", "only for a sphere impact scene (body.kind = \"sphere\", experiment.kind = \"impact\", "
+                              "one asperity radius)");
+      s.cor_table = read_cor_table(*ct);
+    }
     out->finish();
   }
   top.finish();
@@ -889,6 +917,16 @@ std::string to_toml(const Scene& s) {
   if (s.mesh && !s.mesh->export_ply.empty())
     os << "export_ply = " << quote(s.mesh->export_ply) << "\nexport_style = \""
        << (s.mesh->export_points ? "points" : "spheres") << "\"\n";
+  if (s.cor_table) {
+    const CorTableScene& c = *s.cor_table;
+    os << "\n[outputs.cor_table]\nfile = " << quote(c.file) << "\n";
+    if (!c.speeds.empty()) {
+      os << "speeds = [";
+      for (std::size_t i = 0; i < c.speeds.size(); ++i) os << (i ? ", " : "") << num(c.speeds[i]);
+      os << "]\n";
+    }
+    os << "probabilities = " << c.probabilities << "\ndrops = " << c.drops << "\n";
+  }
   return os.str();
 }
 

@@ -9,7 +9,9 @@
 #include <stdexcept>
 
 #include "asperity/app/cor_table.hpp"
+#include "asperity/app/run.hpp"
 #include "asperity/app/scene.hpp"
+#include "asperity/app/scene_file.hpp"
 #include "asperity/cor_table.h"
 
 using namespace asperity;
@@ -71,4 +73,70 @@ TEST(CorTable, TheCHeaderReadsTheCsvAndSamplesItsNodes) {
     }
   asperity_cor_free(&c);
   std::filesystem::remove_all(dir);
+}
+
+// outputs.cor_table in a scene file: read, validated with the key named, written back by to_toml,
+// and run with the scene: the table lands beside the report, which names its ensemble.
+namespace {
+std::string fig4_with_table(const std::string& table) {
+  std::string text(preset_text("fig4"));
+  return text + "\n[outputs.cor_table]\n" + table;
+}
+
+void expect_scene_error(const std::string& text, const std::string& key, const std::string& also) {
+  try {
+    parse_scene(text, "t.toml");
+    ADD_FAILURE() << "accepted, expected an error naming " << key;
+  } catch (const SceneError& e) {
+    EXPECT_EQ(e.key(), key) << e.what();
+    EXPECT_NE(std::string(e.what()).find(also), std::string::npos) << e.what();
+  }
+}
+}  // namespace
+
+TEST(CorTableScene, ReadValidatedAndWrittenBack) {
+  const Scene s = parse_scene(fig4_with_table("file = \"steel.csv\"\nspeeds = [0.5, 2]\nprobabilities = 11\ndrops = 300\n"), "t.toml");
+  ASSERT_TRUE(s.cor_table);
+  EXPECT_EQ(s.cor_table->file, "steel.csv");
+  EXPECT_EQ(s.cor_table->speeds, (std::vector<double>{0.5, 2.0}));
+  EXPECT_EQ(s.cor_table->probabilities, 11u);
+  EXPECT_EQ(s.cor_table->drops, 300u);
+  EXPECT_EQ(parse_scene(to_toml(s), "again.toml"), s);
+  EXPECT_EQ(cor_table_spec(s, *s.cor_table).speeds, s.cor_table->speeds);
+
+  expect_scene_error(fig4_with_table("speeds = [1]\n"), "outputs.cor_table.file", "missing");
+  expect_scene_error(fig4_with_table("file = \"t.csv\"\nspeeds = [2, 1]\n"), "outputs.cor_table.speeds", "ascend");
+  expect_scene_error(fig4_with_table("file = \"t.csv\"\nspeeds = [0, 1]\n"), "outputs.cor_table.speeds", "> 0");
+  expect_scene_error(fig4_with_table("file = \"t.csv\"\nprobabilities = 1\n"), "outputs.cor_table.probabilities", ">= 2");
+  expect_scene_error(fig4_with_table("file = \"t.csv\"\ndrops = 2\n"), "outputs.cor_table.drops", ">= 3");
+  expect_scene_error(fig4_with_table("file = \"t.csv\"\ncolour = 1\n"), "outputs.cor_table.colour", "unknown");
+  expect_scene_error(fig4_with_table("file = \"../t.csv\"\n"), "outputs.cor_table.file", "'/'");
+  expect_scene_error(fig4_with_table("file = \"t.txt\"\n"), "outputs.cor_table.file", ".csv");
+  expect_scene_error(fig4_with_table("file = \"report.csv\"\n"), "outputs.cor_table.file", "report.json");
+  std::string contact(preset_text("fig3"));
+  expect_scene_error(contact + "\n[outputs.cor_table]\nfile = \"t.csv\"\n", "outputs.cor_table", "sphere impact scene");
+}
+
+TEST(CorTableScene, TheRunWritesTheTableBesideTheReport) {
+  Scene s = parse_scene(fig4_with_table("file = \"steel.csv\"\nspeeds = [0.5, 2]\nprobabilities = 11\ndrops = 300\n"), "t.toml");
+  s.ensemble.sphere.asperities = 1000;
+  s.ensemble.drops = 2000;
+  s.plots = false;
+  const auto out = std::filesystem::temp_directory_path() / "asperity-test-cor-table-scene";
+  std::filesystem::remove_all(out);
+  s.out = out;
+  const SceneOutput o = run_scene_output(s, {}, nullptr, {});
+  EXPECT_NE(std::find(o.files.begin(), o.files.end(), "steel.csv"), o.files.end());
+  EXPECT_TRUE(std::filesystem::exists(out / "steel.csv"));
+  EXPECT_TRUE(std::filesystem::exists(out / "steel.json"));
+  EXPECT_NE(o.json.find("\"cor_table\""), std::string::npos);
+  EXPECT_NE(o.json.find(kCorTableEnsemble), std::string::npos) << "the report says the table is sampled, not geometric";
+  EXPECT_NE(o.table.find("restitution table: steel.csv"), std::string::npos) << o.table;
+  asperity_cor_table c;
+  char err[256] = "";
+  ASSERT_EQ(asperity_cor_load(&c, (out / "steel.csv").c_str(), err, sizeof err), 0) << err;
+  EXPECT_EQ(c.n_speeds, 2);
+  EXPECT_EQ(c.n_probs, 11);
+  asperity_cor_free(&c);
+  std::filesystem::remove_all(out);
 }

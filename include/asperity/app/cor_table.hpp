@@ -34,6 +34,14 @@ struct CorTableSpec {
 /// of `speeds` points from u/10 to 10 u around the scene's impact speed u (overwrite as needed).
 CorTableSpec cor_table_spec(const Scene& s, std::size_t speeds = 9);
 
+/// The table a scene's outputs.cor_table asks for: cor_table_spec(s) with its speeds (if given),
+/// probabilities and drops.
+CorTableSpec cor_table_spec(const Scene& s, const CorTableScene& c);
+
+/// What produced the table, for reports and headers: the ensemble and method, never "geometry".
+inline constexpr const char* kCorTableEnsemble =
+    "sampled from the exact finite-N law of the lowest asperity (no sphere is built)";
+
 /// Throws std::invalid_argument naming the field and value.
 void validate(const CorTableSpec& spec);
 
