@@ -269,7 +269,8 @@ void write_scene_cor_table(const Scene& s, const Progress& progress, const std::
   const double seconds = since(t0);
   h.timings_s.emplace_back("cor_table", seconds);
   const nlohmann::json j = {{"file", s.cor_table->file}, {"header", header},     {"ensemble", kCorTableEnsemble},
-                            {"speeds", spec.speeds},    {"probabilities", spec.probabilities}, {"drops_per_speed", spec.drops}};
+                            {"speeds", spec.speeds},    {"probabilities", spec.probabilities}, {"drops_per_speed", spec.drops},
+                            {"format", t.format()},      {"spins", spec.spins},  {"omega_bands", spec.omega_bands}};
   h.sections.emplace_back("cor_table", j.dump());
   std::ostringstream line;
   line << "\nrestitution table: " << s.cor_table->file << " (+ " << header << "), " << spec.speeds.size() << " speeds x "

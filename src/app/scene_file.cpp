@@ -246,7 +246,7 @@ class Reader {
 
 constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
 
-// [outputs.cor_table]: file (required), speeds, probabilities, drops. The names are checked against
+// [outputs.cor_table]: file (required), speeds, probabilities, drops, spins, omega_bands. The names are checked against
 // the run's other outputs by validate(Scene); the table's own ranges here, each key named.
 CorTableScene read_cor_table(Reader& t) {
   CorTableScene c;
@@ -264,6 +264,18 @@ CorTableScene read_cor_table(Reader& t) {
   }
   if (auto p = t.count("probabilities", 2, 100001)) c.probabilities = *p;
   if (auto d = t.count("drops", 3, kMaxDrops)) c.drops = *d;
+  if (auto w = t.reals("spins")) {
+    for (std::size_t i = 0; i < w->size(); ++i) {
+      if (std::abs((*w)[i]) > 1e6) t.bad("spins", "each |spin| must be <= 1e6 rad/s, got " + num((*w)[i]));
+      if (i > 0 && !((*w)[i] > (*w)[i - 1])) t.bad("spins", "must ascend strictly, got " + num((*w)[i - 1]) + " then " + num((*w)[i]));
+    }
+    if (w->size() > 1000) t.bad("spins", "at most 1000 spins, got " + std::to_string(w->size()));
+    c.spins = *w;
+  }
+  if (auto b = t.count("omega_bands", 0, 1000)) {
+    if (2 * *b > c.drops) t.bad("omega_bands", "at most drops / 2 = " + std::to_string(c.drops / 2) + ", got " + std::to_string(*b));
+    c.omega_bands = *b;
+  }
   t.finish();
   return c;
 }
@@ -1040,6 +1052,12 @@ std::string to_toml(const Scene& s) {
       os << "]\n";
     }
     os << "probabilities = " << c.probabilities << "\ndrops = " << c.drops << "\n";
+    if (!c.spins.empty()) {
+      os << "spins = [";
+      for (std::size_t i = 0; i < c.spins.size(); ++i) os << (i ? ", " : "") << num(c.spins[i]);
+      os << "]\n";
+    }
+    if (c.omega_bands > 0) os << "omega_bands = " << c.omega_bands << "\n";
   }
   return os.str();
 }

@@ -39,6 +39,8 @@ struct CorTableScene {
   std::vector<double> speeds;    ///< empty: 9 speeds from u/10 to 10 u around the scene's speed u
   std::size_t probabilities = 201;
   std::uint64_t drops = 100000;  ///< per speed
+  std::vector<double> spins;     ///< incoming Omega_x grid [rad/s]; empty: the scene's Omega
+  std::size_t omega_bands = 0;   ///< Omega'_x per eps band (joint draws); 0: none
 
   friend bool operator==(const CorTableScene&, const CorTableScene&) = default;
 };
