@@ -106,7 +106,7 @@ static inline const char *asperity_cor__values(const char *c, const char *line_e
   for (j = 0; j < n; ++j) {
     if (*c != ',') return "row has fewer values than the header";
     x = strtod(c + 1, &e);
-    if (e == c + 1 || x != x || (j > 0 && x < prev)) return "quantiles must be numbers, nondecreasing along a row";
+    if (e == c + 1 || !isfinite(x) || (j > 0 && x < prev)) return "quantiles must be finite numbers, nondecreasing along a row";
     if (asperity_cor__push(v, len, cap, x)) return "out of memory";
     prev = x;
     c = e;
@@ -154,8 +154,8 @@ static inline const char *asperity_cor__row2(asperity_cor_table *t, asperity_cor
                                              const char *line_end) {
   const char *c = s, *why;
   double spin, speed;
-  if (asperity_cor__key(&c, &spin) || spin != spin || asperity_cor__key(&c, &speed) || !(speed > 0.0))
-    return "a row starts with <spin>,<speed>,<row> (speed > 0)";
+  if (asperity_cor__key(&c, &spin) || !isfinite(spin) || asperity_cor__key(&c, &speed) || !(speed > 0.0) || !isfinite(speed))
+    return "a row starts with <spin>,<speed>,<row> (finite numbers, speed > 0)";
   if (strncmp(c, "eps,", 4) == 0) {
     const int new_spin = t->n_spins == 0 || spin != t->spins[t->n_spins - 1];
     if ((why = asperity_cor__end_block(t, g, new_spin)) != NULL) return why;
@@ -193,8 +193,8 @@ static inline const char *asperity_cor__row1(asperity_cor_table *t, asperity_cor
                                              const char *line_end) {
   char *e;
   double v = strtod(s, &e);
-  if (e == s || !(v > 0.0) || (t->n_speeds > 0 && !(v > t->speeds[t->n_speeds - 1])))
-    return "speeds must be > 0 and ascend strictly";
+  if (e == s || !(v > 0.0) || !isfinite(v) || (t->n_speeds > 0 && !(v > t->speeds[t->n_speeds - 1])))
+    return "speeds must be finite, > 0 and ascend strictly";
   if (asperity_cor__push(&t->speeds, &t->n_speeds, &g->cap_s, v)) return "out of memory";
   return asperity_cor__values(e, line_end, t->n_probs, &t->eps, &g->n_e, &g->cap_e);
 }
