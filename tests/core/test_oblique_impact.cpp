@@ -2,8 +2,8 @@
 // closed form, and solve_impact at the inputs of Kharaz, Gorham & Salman (2001) -- the 5 mm Al2O3
 // sphere on soda-lime glass, v = 3.9 m/s, e_n = 0.98, mu = 0.092, also test 4 of Chung & Ooi's DEM
 // benchmark (2011) -- against the published points digitised in tests/data/ (provenance in each
-// CSV's header). All predictions here are rigid-body impulse laws at the sphere's pole (lazy exact
-// sphere: no asperities), not geometry.
+// CSV's header). All predictions here are rigid-body impulse laws for a smooth sphere hit at its
+// pole: no asperities, no geometry queries.
 #include <gtest/gtest.h>
 
 #include <boost/math/distributions/fisher_f.hpp>
