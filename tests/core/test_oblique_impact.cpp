@@ -288,8 +288,8 @@ TEST(ObliqueImpact, EveryLawMatchesItsClosedForm) {
 }
 
 TEST(ObliqueImpact, MeasuredReboundMatchesCoulombInTheSlidingRegime) {
-  // Kharaz et al.'s measurements (two independent digitisations: Lethe's of the paper, Kratos' of
-  // Chung & Ooi's re-plot) at incidence >= 35 deg, per series and quantity (n = 3..6 points): the
+  // Kharaz et al.'s measurements (two digitisations: Lethe's, attributed to the paper, and Kratos'
+  // of Chung & Ooi's re-plot) at incidence >= 35 deg, per series and quantity (n = 3..6 points): the
   // extra-sum-of-squares F test of each law against the best Coulomb law (F(1, n-1); the scatter
   // is the data's own about that fit). alpha = 0.01 per dataset: 6 datasets, so a true law fails
   // somewhere with probability <= 6 %. Every Coulomb rule and Walton (whose sliding branch is
