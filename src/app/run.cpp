@@ -76,7 +76,7 @@ RadiiExperiment radii_experiment(const Scene& s) {
 std::vector<std::string> skipped_of(const std::vector<LawCheck>& tests) {
   std::vector<std::string> out;
   for (const auto& t : tests)
-    if (t.decisive && t.verdict == Verdict::skipped) out.push_back(t.quantity + " " + t.law + ": " + t.note);
+    if (unresolved(t)) out.push_back(t.quantity + " " + t.law + ": " + t.note);
   return out;
 }
 
@@ -259,8 +259,7 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
   o.files = r.plots;
   o.rejected = r.rejected();
   for (const auto& t : r.tests)
-    if (t.decisive && (t.verdict == "skipped" || t.verdict == "undecided"))
-      o.skipped.push_back(t.quantity + " " + t.law + " (" + t.verdict + "): " + t.note);
+    if (unresolved(t)) o.skipped.push_back(t.quantity + " " + t.law + " (" + std::string(to_string(t.verdict)) + "): " + t.note);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = r.scene.name;
