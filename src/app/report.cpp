@@ -575,6 +575,66 @@ std::string format_table(const GeometryReport& r) {
   return os.str();
 }
 
+namespace {
+
+nlohmann::json impact_json(const ImpactExperiment& x) {
+  return {{"speed_m_s", x.speed},
+          {"omega_rad_s", {x.omega.x(), x.omega.y(), x.omega.z()}},
+          {"density_kg_m3", x.density},
+          {"beta", x.beta},
+          {"eps_t", x.eps_t},
+          {"restitution_model", "viscoelastic-pade14"},
+          {"solver", "closed form (Sherman-Morrison), tested against the general 3x3 solve"}};
+}
+
+nlohmann::json design_json(const GeometryReport& r) {
+  const auto& d = r.design;
+  return {{"kind", d.kind},
+          {"label", design_label(r)},
+          {"spheres", d.spheres},
+          {"rotations_per_sphere", d.rotations_per_sphere},
+          {"backend", d.backend},
+          {"statistical_scale", d.statistical_scale},
+          {"quenched_scale", d.quenched_scale},
+          {"model_error_scale", d.model_error_scale}};
+}
+
+nlohmann::json quantities_json(const std::vector<QuantityReport>& quantities) {
+  using nlohmann::json;
+  json q = json::object();
+  for (const auto& qr : quantities) {
+    const auto& s = qr.summary;
+    json qs = json::array();
+    for (std::size_t i = 0; i < s.probs.size(); ++i)
+      qs.push_back({{"p", s.probs[i]}, {"value", s.quantiles[i].value}, {"se", s.quantiles[i].se}});
+    q[qr.name] = {{"unit", si_unit(qr.name)},     {"n", s.n},       {"mean", s.mean.value}, {"mean_se", s.mean.se},
+                  {"std", s.std.value}, {"std_se", s.std.se}, {"quantiles", qs},   {"se_batches", s.batches}};
+  }
+  return q;
+}
+
+nlohmann::json tests_json(const std::vector<TestReport>& rows) {
+  using nlohmann::json;
+  json tests = json::array();
+  for (const auto& t : rows) {
+    tests.push_back({{"quantity", t.quantity},
+                     {"law", t.law},
+                     {"scope", t.scope},
+                     {"statistic", t.statistic},
+                     {"D", std::isnan(t.D) ? json(nullptr) : json(t.D)},
+                     {"p", std::isnan(t.p) ? json(nullptr) : json(t.p)},
+                     {"n", t.n},
+                     {"predicted_mean", t.predicted_mean},
+                     {"iid", t.iid},
+                     {"decisive", t.decisive},
+                     {"verdict", std::string(to_string(t.verdict))},
+                     {"note", t.note}});
+  }
+  return tests;
+}
+
+}  // namespace
+
 std::string to_json(const GeometryReport& r) {
   using nlohmann::json;
   const auto& e = r.scene.ensemble;
@@ -596,62 +656,21 @@ std::string to_json(const GeometryReport& r) {
                      {"backend", e.mode == Mode::explicit_spheres ? std::string(to_string(e.backend)) : std::string("none")},
                      {"alpha", r.scene.alpha}};
   if (e.impact.enabled) {
-    const auto& x = e.impact;
-    j["impact"] = {{"speed_m_s", x.speed},
-                   {"omega_rad_s", {x.omega.x(), x.omega.y(), x.omega.z()}},
-                   {"density_kg_m3", x.density},
-                   {"beta", x.beta},
-                   {"eps_t", x.eps_t},
-                   {"restitution_model", "viscoelastic-pade14"},
-                   {"solver", "closed form (Sherman-Morrison), tested against the general 3x3 solve"}};
+    j["impact"] = impact_json(e.impact);
     j["no_impacts"] = r.no_impacts;
     j["eps_n_mean"] = r.eps_n_mean;
     j["eps_deficit"] = {{"value", r.eps_deficit.value}, {"se", r.eps_deficit.se}};
   }
   j["ensemble_note"] = r.ensemble_note;
   if (e.mode == Mode::explicit_spheres) j["quenched_deviation_scale"] = r.quenched_scale;
-  {
-    const auto& d = r.design;
-    j["design"] = {{"kind", d.kind},
-                   {"label", design_label(r)},
-                   {"spheres", d.spheres},
-                   {"rotations_per_sphere", d.rotations_per_sphere},
-                   {"backend", d.backend},
-                   {"statistical_scale", d.statistical_scale},
-                   {"quenched_scale", d.quenched_scale},
-                   {"model_error_scale", d.model_error_scale}};
-    if (d.kind == "explicit")
-      j["cross_check"] = {{"queries", r.cross_check.queries},
-                          {"agreed", r.cross_check.agreed},
-                          {"backends", r.cross_check.backends}};
-  }
+  j["design"] = design_json(r);
+  if (r.design.kind == "explicit")
+    j["cross_check"] = {{"queries", r.cross_check.queries},
+                        {"agreed", r.cross_check.agreed},
+                        {"backends", r.cross_check.backends}};
   j["runner_up_gap_m"] = {{"min", r.gap_min}, {"median", r.gap_median}};
-  json q = json::object();
-  for (const auto& qr : r.quantities) {
-    const auto& s = qr.summary;
-    json qs = json::array();
-    for (std::size_t i = 0; i < s.probs.size(); ++i)
-      qs.push_back({{"p", s.probs[i]}, {"value", s.quantiles[i].value}, {"se", s.quantiles[i].se}});
-    q[qr.name] = {{"unit", si_unit(qr.name)},     {"n", s.n},       {"mean", s.mean.value}, {"mean_se", s.mean.se},
-                  {"std", s.std.value}, {"std_se", s.std.se}, {"quantiles", qs},   {"se_batches", s.batches}};
-  }
-  j["quantities"] = q;
-  json tests = json::array();
-  for (const auto& t : r.tests) {
-    tests.push_back({{"quantity", t.quantity},
-                     {"law", t.law},
-                     {"scope", t.scope},
-                     {"statistic", t.statistic},
-                     {"D", std::isnan(t.D) ? json(nullptr) : json(t.D)},
-                     {"p", std::isnan(t.p) ? json(nullptr) : json(t.p)},
-                     {"n", t.n},
-                     {"predicted_mean", t.predicted_mean},
-                     {"iid", t.iid},
-                     {"decisive", t.decisive},
-                     {"verdict", std::string(to_string(t.verdict))},
-                     {"note", t.note}});
-  }
-  j["tests"] = tests;
+  j["quantities"] = quantities_json(r.quantities);
+  j["tests"] = tests_json(r.tests);
   j["rejected"] = r.rejected();
   j["skipped"] = r.skipped();
   j["timings_s"] = timings_json(r.timings_s);
