@@ -191,14 +191,11 @@ nlohmann::json timings_json(const std::vector<std::pair<std::string, double>>& t
 }  // namespace
 
 bool GeometryReport::rejected() const {
-  return std::any_of(tests.begin(), tests.end(), [](const TestReport& t) { return t.decisive && t.verdict == "reject"; });
+  return std::any_of(tests.begin(), tests.end(), [](const TestReport& t) { return rejects(t); });
 }
 
 std::size_t GeometryReport::skipped() const {
-  return static_cast<std::size_t>(
-      std::count_if(tests.begin(), tests.end(), [](const TestReport& t) {
-        return t.decisive && (t.verdict == "skipped" || t.verdict == "undecided");
-      }));
+  return static_cast<std::size_t>(std::count_if(tests.begin(), tests.end(), [](const TestReport& t) { return unresolved(t); }));
 }
 
 namespace {
@@ -314,11 +311,26 @@ struct TestContext {
   std::string statistic;  ///< of the law tests: "KS-sphere-bootstrap" (explicit) or "KS"
 };
 
-// A law the run could not test: verdict "skipped", D, p and predicted_mean NaN.
+// A row of tests[] named by what it tests; the caller sets the rest by name.
+TestReport test_row(const std::string& quantity, const std::string& law, const std::string& statistic, std::uint64_t n) {
+  TestReport t;
+  t.quantity = quantity;
+  t.law = law;
+  t.statistic = statistic;
+  t.n = n;
+  return t;
+}
+
+// A law the run could not test: verdict skipped, D, p and predicted_mean NaN.
 TestReport skipped_test(const TestContext& c, const std::string& quantity, const std::string& law, bool decisive_law,
                         std::size_t count, const std::string& reason) {
-  return {quantity, law, "all", c.statistic, kNaN, kNaN, count, kNaN, !c.v.expl, decisive_law && c.v.decisive,
-          "skipped", "not tested: " + reason};
+  TestReport t = test_row(quantity, law, c.statistic, count);
+  t.D = t.p = t.predicted_mean = kNaN;
+  t.iid = !c.v.expl;
+  t.decisive = decisive_law && c.v.decisive;
+  t.verdict = Verdict::skipped;
+  t.note = "not tested: " + reason;
+  return t;
 }
 
 // The laws of `set` that can be evaluated (at x[0]), as (index, cdf); the others are skipped, with
@@ -346,9 +358,12 @@ TestReport explicit_test(const TestContext& c, const LawSet& set, std::size_t li
                          const BlockBins& bins, std::size_t count) {
   const Law& law = set.laws[li];
   const bool decisive_law = set.decisive[li];
-  TestReport t{set.quantity, law.name, "all", c.statistic, res.D, res.p, count, law.mean, false,
-               decisive_law && c.v.decisive && res.verdict != "not-decisive", res.verdict, ""};
-  if (res.verdict == "not-decisive") {
+  TestReport t = test_row(set.quantity, law.name, c.statistic, count);
+  t.D = res.D, t.p = res.p, t.predicted_mean = law.mean;
+  t.iid = false;
+  t.decisive = decisive_law && c.v.decisive && res.verdict != Verdict::not_decisive;
+  t.verdict = res.verdict;
+  if (res.verdict == Verdict::not_decisive) {
     t.p = kolmogorov_pvalue(res.D, count);
     t.note = c.v.K == 1 ? "one sphere: that sphere's own law against the ensemble law; the p-value assumes iid drops "
                           "(they are not): decides nothing"
@@ -357,7 +372,7 @@ TestReport explicit_test(const TestContext& c, const LawSet& set, std::size_t li
   } else {
     t.note = "B = " + std::to_string(res.replicates) + " sphere-block bootstrap replicates over " +
              std::to_string(bins.blocks) + " blocks";
-    if (res.verdict == "undecided") t.note += "; cannot decide at this B (smallest attainable p is not below alpha)";
+    if (res.verdict == Verdict::undecided) t.note += "; cannot decide at this B (smallest attainable p is not below alpha)";
     if (!decisive_law) t.note = kPrintedNote + "; " + t.note;
   }
   if (set.has_atom.size() > li && set.has_atom[li])
@@ -387,7 +402,7 @@ void test_explicit(GeometryReport& r, const TestContext& c, const LawSet& set, s
     if (c.v.decisive && x.size() == c.v.n) {
       res = block_ks_tests(bins, cdfs, c.scene.alpha, c.scene.ensemble.seed, stream);
     } else {
-      for (const auto& f : cdfs) res.push_back({binned_ks_distance(bins, f), kNaN, 0, "not-decisive"});
+      for (const auto& f : cdfs) res.push_back({binned_ks_distance(bins, f), kNaN, 0, Verdict::not_decisive});
     }
   } catch (const std::exception& ex) {
     for (const auto& [li, cdf] : laws)
@@ -405,7 +420,10 @@ void test_sampled(GeometryReport& r, const TestContext& c, const LawSet& set) {
   for (std::size_t li = 0; li < set.laws.size(); ++li) {
     const Law& law = set.laws[li];
     const bool decisive_law = set.decisive[li];
-    TestReport t{set.quantity, law.name, "all", "KS", 0, 1, x0.size(), law.mean, true, decisive_law, "", ""};
+    TestReport t = test_row(set.quantity, law.name, "KS", x0.size());
+    t.D = 0, t.p = 1, t.predicted_mean = law.mean;
+    t.iid = true;
+    t.decisive = decisive_law;
     if (!decisive_law) t.note = kPrintedNote;
     const bool atom = li < set.has_atom.size() && set.has_atom[li];
     KsResult ks;
@@ -421,7 +439,7 @@ void test_sampled(GeometryReport& r, const TestContext& c, const LawSet& set) {
     }
     if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
     t.D = ks.D, t.p = ks.p;
-    t.verdict = ks.p < c.scene.alpha ? "reject" : "accept";
+    t.verdict = ks.p < c.scene.alpha ? Verdict::reject : Verdict::accept;
     r.tests.push_back(t);
   }
 }
@@ -446,14 +464,16 @@ void test_laws(GeometryReport& r, const TestContext& c) {
 // design the count of one sphere is overdispersed (its own core probability): information only.
 TestReport core_contact_test(const GeometryReport& r, const Scene& scene, const ContactSamples& s, const DesignView& v) {
   const std::size_t n = v.n;
-  TestReport t{"core_contacts", "exact-sphere", "all", "binomial", kNaN, 1, n,
-               r.core_probability * double(n), !v.expl, !v.expl, "", ""};
+  TestReport t = test_row("core_contacts", "exact-sphere", "binomial", n);
+  t.D = kNaN, t.p = 1, t.predicted_mean = r.core_probability * double(n);
+  t.iid = !v.expl;
+  t.decisive = !v.expl;
   boost::math::binomial_distribution<double> b(double(n), r.core_probability);
   const double k = double(s.core_contacts);
   const double lower = boost::math::cdf(b, k);
   const double upper = k > 0 ? boost::math::cdf(boost::math::complement(b, k - 1)) : 1.0;
   t.p = std::min(1.0, 2.0 * std::min(lower, upper));
-  t.verdict = t.p < scene.alpha ? "reject" : "accept";
+  t.verdict = t.p < scene.alpha ? Verdict::reject : Verdict::accept;
   t.note = "central sphere touched first; the paper's estimate exp(-N a/R) = " + fmt(r.core_probability_paper, 3) +
            " per drop, exact (1 - a/2R)^N = " + fmt(r.core_probability, 3);
   if (v.expl) t.note += "; iid binomial p-value, the spread between spheres is not accounted for: information only";
@@ -515,7 +535,7 @@ std::string format_table(const GeometryReport& r) {
         if (q.name == t.quantity)
           measured = fmt(q.summary.mean.value * scale, digits) + " +- " + fmt(q.summary.mean.se * scale, 2);
     }
-    std::string verdict = t.verdict;
+    std::string verdict(to_string(t.verdict));
     if (!t.decisive) verdict += " (info)";
     os << std::left << std::setw(14) << t.quantity << std::setw(24) << measured << std::setw(18) << t.law
        << std::setw(12) << fmt(t.predicted_mean * scale, t.quantity == "eps" ? 8 : 5) << std::setw(21) << t.statistic << std::setw(10) << fmt(t.D, 3)
@@ -550,10 +570,70 @@ std::string format_table(const GeometryReport& r) {
        << " SKIPPED or UNDECIDED (could not be evaluated or decided, see the notes)";
   os << "\n";
   for (const auto& t : r.tests)  // the rows show the others
-    if (t.decisive && (t.verdict == "skipped" || t.verdict == "undecided"))
-      os << t.verdict << ": " << t.quantity << " " << t.law << " (" << t.scope << "): " << t.note << "\n";
+    if (unresolved(t))
+      os << to_string(t.verdict) << ": " << t.quantity << " " << t.law << " (" << t.scope << "): " << t.note << "\n";
   return os.str();
 }
+
+namespace {
+
+nlohmann::json impact_json(const ImpactExperiment& x) {
+  return {{"speed_m_s", x.speed},
+          {"omega_rad_s", {x.omega.x(), x.omega.y(), x.omega.z()}},
+          {"density_kg_m3", x.density},
+          {"beta", x.beta},
+          {"eps_t", x.eps_t},
+          {"restitution_model", "viscoelastic-pade14"},
+          {"solver", "closed form (Sherman-Morrison), tested against the general 3x3 solve"}};
+}
+
+nlohmann::json design_json(const GeometryReport& r) {
+  const auto& d = r.design;
+  return {{"kind", d.kind},
+          {"label", design_label(r)},
+          {"spheres", d.spheres},
+          {"rotations_per_sphere", d.rotations_per_sphere},
+          {"backend", d.backend},
+          {"statistical_scale", d.statistical_scale},
+          {"quenched_scale", d.quenched_scale},
+          {"model_error_scale", d.model_error_scale}};
+}
+
+nlohmann::json quantities_json(const std::vector<QuantityReport>& quantities) {
+  using nlohmann::json;
+  json q = json::object();
+  for (const auto& qr : quantities) {
+    const auto& s = qr.summary;
+    json qs = json::array();
+    for (std::size_t i = 0; i < s.probs.size(); ++i)
+      qs.push_back({{"p", s.probs[i]}, {"value", s.quantiles[i].value}, {"se", s.quantiles[i].se}});
+    q[qr.name] = {{"unit", si_unit(qr.name)},     {"n", s.n},       {"mean", s.mean.value}, {"mean_se", s.mean.se},
+                  {"std", s.std.value}, {"std_se", s.std.se}, {"quantiles", qs},   {"se_batches", s.batches}};
+  }
+  return q;
+}
+
+nlohmann::json tests_json(const std::vector<TestReport>& rows) {
+  using nlohmann::json;
+  json tests = json::array();
+  for (const auto& t : rows) {
+    tests.push_back({{"quantity", t.quantity},
+                     {"law", t.law},
+                     {"scope", t.scope},
+                     {"statistic", t.statistic},
+                     {"D", std::isnan(t.D) ? json(nullptr) : json(t.D)},
+                     {"p", std::isnan(t.p) ? json(nullptr) : json(t.p)},
+                     {"n", t.n},
+                     {"predicted_mean", t.predicted_mean},
+                     {"iid", t.iid},
+                     {"decisive", t.decisive},
+                     {"verdict", std::string(to_string(t.verdict))},
+                     {"note", t.note}});
+  }
+  return tests;
+}
+
+}  // namespace
 
 std::string to_json(const GeometryReport& r) {
   using nlohmann::json;
@@ -576,62 +656,21 @@ std::string to_json(const GeometryReport& r) {
                      {"backend", e.mode == Mode::explicit_spheres ? std::string(to_string(e.backend)) : std::string("none")},
                      {"alpha", r.scene.alpha}};
   if (e.impact.enabled) {
-    const auto& x = e.impact;
-    j["impact"] = {{"speed_m_s", x.speed},
-                   {"omega_rad_s", {x.omega.x(), x.omega.y(), x.omega.z()}},
-                   {"density_kg_m3", x.density},
-                   {"beta", x.beta},
-                   {"eps_t", x.eps_t},
-                   {"restitution_model", "viscoelastic-pade14"},
-                   {"solver", "closed form (Sherman-Morrison), tested against the general 3x3 solve"}};
+    j["impact"] = impact_json(e.impact);
     j["no_impacts"] = r.no_impacts;
     j["eps_n_mean"] = r.eps_n_mean;
     j["eps_deficit"] = {{"value", r.eps_deficit.value}, {"se", r.eps_deficit.se}};
   }
   j["ensemble_note"] = r.ensemble_note;
   if (e.mode == Mode::explicit_spheres) j["quenched_deviation_scale"] = r.quenched_scale;
-  {
-    const auto& d = r.design;
-    j["design"] = {{"kind", d.kind},
-                   {"label", design_label(r)},
-                   {"spheres", d.spheres},
-                   {"rotations_per_sphere", d.rotations_per_sphere},
-                   {"backend", d.backend},
-                   {"statistical_scale", d.statistical_scale},
-                   {"quenched_scale", d.quenched_scale},
-                   {"model_error_scale", d.model_error_scale}};
-    if (d.kind == "explicit")
-      j["cross_check"] = {{"queries", r.cross_check.queries},
-                          {"agreed", r.cross_check.agreed},
-                          {"backends", r.cross_check.backends}};
-  }
+  j["design"] = design_json(r);
+  if (r.design.kind == "explicit")
+    j["cross_check"] = {{"queries", r.cross_check.queries},
+                        {"agreed", r.cross_check.agreed},
+                        {"backends", r.cross_check.backends}};
   j["runner_up_gap_m"] = {{"min", r.gap_min}, {"median", r.gap_median}};
-  json q = json::object();
-  for (const auto& qr : r.quantities) {
-    const auto& s = qr.summary;
-    json qs = json::array();
-    for (std::size_t i = 0; i < s.probs.size(); ++i)
-      qs.push_back({{"p", s.probs[i]}, {"value", s.quantiles[i].value}, {"se", s.quantiles[i].se}});
-    q[qr.name] = {{"unit", si_unit(qr.name)},     {"n", s.n},       {"mean", s.mean.value}, {"mean_se", s.mean.se},
-                  {"std", s.std.value}, {"std_se", s.std.se}, {"quantiles", qs},   {"se_batches", s.batches}};
-  }
-  j["quantities"] = q;
-  json tests = json::array();
-  for (const auto& t : r.tests) {
-    tests.push_back({{"quantity", t.quantity},
-                     {"law", t.law},
-                     {"scope", t.scope},
-                     {"statistic", t.statistic},
-                     {"D", std::isnan(t.D) ? json(nullptr) : json(t.D)},
-                     {"p", std::isnan(t.p) ? json(nullptr) : json(t.p)},
-                     {"n", t.n},
-                     {"predicted_mean", t.predicted_mean},
-                     {"iid", t.iid},
-                     {"decisive", t.decisive},
-                     {"verdict", t.verdict},
-                     {"note", t.note}});
-  }
-  j["tests"] = tests;
+  j["quantities"] = quantities_json(r.quantities);
+  j["tests"] = tests_json(r.tests);
   j["rejected"] = r.rejected();
   j["skipped"] = r.skipped();
   j["timings_s"] = timings_json(r.timings_s);

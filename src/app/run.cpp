@@ -37,25 +37,53 @@ RadiusDistribution scene_radii(const Scene& s) {
   return s.radii ? s.radii->radii : RadiusDistribution::fixed(s.ensemble.sphere.asperity_radius);
 }
 
+// A Scene holds the sphere runs' own config types (EnsembleConfig, BounceExperiment); the runs of
+// body_experiments.hpp and body_bounce.hpp take theirs from one conversion function each, below.
+// The rough mesh bodies are the same for all of them (impacts, bounces, the PLY export): a field
+// of the bodies is read from the Scene here only.
+struct SceneBodies {
+  std::filesystem::path file;
+  double scale = 1;
+  std::vector<double> smooth;
+  std::uint64_t asperities = 0;  ///< N per body
+  RadiusDistribution radii;
+  double density = 0;
+  std::uint64_t bodies = 0;      ///< K
+  std::uint64_t seed = 0;
+};
+
+SceneBodies scene_bodies(const Scene& s) {
+  const auto& e = s.ensemble;
+  return {s.mesh->file, s.mesh->scale, s.mesh->smooth, e.sphere.asperities, scene_radii(s), e.impact.density,
+          e.spheres, e.seed};
+}
+
 MeshImpactExperiment mesh_experiment(const Scene& s) {
   const auto& e = s.ensemble;
+  const SceneBodies b = scene_bodies(s);
   MeshImpactExperiment m;
-  m.mesh = s.mesh->file;
-  m.scale = s.mesh->scale;
-  m.smooth_ellipsoid = s.mesh->smooth;
-  m.asperities = e.sphere.asperities;
-  m.radii = scene_radii(s);
+  m.mesh = b.file, m.scale = b.scale, m.smooth_ellipsoid = b.smooth;
+  m.asperities = b.asperities, m.radii = b.radii, m.density = b.density, m.bodies = b.bodies, m.seed = b.seed;
   if (s.radii) m.screen_bodies = s.radii->screen_bodies, m.screen_directions = s.radii->screen_directions;
-  m.density = e.impact.density;
-  m.bodies = e.spheres;
   m.drops = e.drops;
   m.speed = e.impact.speed;
   m.omega = e.impact.omega;
   m.beta = e.impact.beta;
   m.eps_t = e.impact.eps_t;
   m.tangential = e.impact.tangential;
-  m.seed = e.seed;
   m.alpha = s.alpha;
+  m.plots = s.plots;
+  return m;
+}
+
+MeshBounceExperiment mesh_bounce_experiment(const Scene& s) {
+  const SceneBodies b = scene_bodies(s);
+  MeshBounceExperiment m;
+  m.mesh = b.file, m.scale = b.scale, m.smooth = b.smooth;
+  m.asperities = b.asperities, m.radii = b.radii, m.density = b.density, m.bodies = b.bodies, m.seed = b.seed;
+  m.threads = s.ensemble.threads;
+  m.options.bounce = s.bounce;
+  m.options.tangential = s.ensemble.impact.tangential;
   m.plots = s.plots;
   return m;
 }
@@ -78,7 +106,7 @@ RadiiExperiment radii_experiment(const Scene& s) {
 std::vector<std::string> skipped_of(const std::vector<LawCheck>& tests) {
   std::vector<std::string> out;
   for (const auto& t : tests)
-    if (t.decisive && t.verdict == Verdict::skipped) out.push_back(t.quantity + " " + t.law + ": " + t.note);
+    if (unresolved(t)) out.push_back(t.quantity + " " + t.law + ": " + t.note);
   return out;
 }
 
@@ -108,11 +136,11 @@ PlanStage export_stage(const Scene& s, double seconds) {
 
 // The first body of a mesh scene (same seed and index as the run's body 0) as PLY.
 void export_first_body(const Scene& s, const TriangleMesh& mesh, const std::filesystem::path& dir) {
-  const double density = s.ensemble.impact.density;
-  const RoughBody b = make_rough_mesh_body(mesh, s.ensemble.sphere.asperities, scene_radii(s), density, s.ensemble.seed, 0,
-                                           smooth_surface(s.mesh->smooth), s.mesh->file.stem().string());
+  const SceneBodies sb = scene_bodies(s);
+  const RoughBody b = make_rough_mesh_body(mesh, sb.asperities, sb.radii, sb.density, sb.seed, 0,
+                                           smooth_surface(sb.smooth), sb.file.stem().string());
   write_ply(dir / s.mesh->export_ply, b, s.mesh->export_points ? PlyStyle::points : PlyStyle::spheres, 1.0, &mesh,
-            -mass_properties(mesh, density).centroid);
+            -mass_properties(mesh, sb.density).centroid);
 }
 
 SceneOutput run_radii(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
@@ -209,20 +237,7 @@ SceneOutput run_bounce(const Scene& s, std::ostream* log, const std::filesystem:
 }
 
 SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
-  const auto& e = s.ensemble;
-  MeshBounceExperiment m;
-  m.mesh = s.mesh->file;
-  m.scale = s.mesh->scale;
-  m.smooth = s.mesh->smooth;
-  m.asperities = e.sphere.asperities;
-  m.radii = scene_radii(s);
-  m.density = e.impact.density;
-  m.bodies = e.spheres;
-  m.seed = e.seed;
-  m.threads = e.threads;
-  m.options.bounce = s.bounce;
-  m.options.tangential = e.impact.tangential;
-  m.plots = s.plots;
+  const MeshBounceExperiment m = mesh_bounce_experiment(s);
   const std::optional<TriangleMesh> mesh =
       m.mesh.empty() ? std::nullopt : std::optional<TriangleMesh>(read_mesh(m.mesh, m.scale));
   SceneOutput o;
@@ -284,8 +299,7 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
   o.files = r.plots;
   o.rejected = r.rejected();
   for (const auto& t : r.tests)
-    if (t.decisive && (t.verdict == "skipped" || t.verdict == "undecided"))
-      o.skipped.push_back(t.quantity + " " + t.law + " (" + t.verdict + "): " + t.note);
+    if (unresolved(t)) o.skipped.push_back(t.quantity + " " + t.law + " (" + std::string(to_string(t.verdict)) + "): " + t.note);
   o.table = format_table(r);
   ReportHeader h;
   h.scene = r.scene.name;

@@ -91,23 +91,9 @@ void validate_cor_table(const Scene& s) {
                                   "\" must differ from the report and its table (\"" + taken + "\")");
 }
 
-}  // namespace
-
-void validate(const Scene& s) {
-  if (s.mesh) {
-    // A mesh body's size is its mesh x scale (check_scene_inputs, run.hpp, checks the asperity
-    // radius against it): the sphere radius is unused and must not refuse the asperity radius.
-    EnsembleConfig e = s.ensemble;
-    e.sphere.radius = std::max(e.sphere.radius, 2.0 * e.sphere.asperity_radius);
-    validate(e);
-  } else {
-    validate(s.ensemble);
-  }
-  if (!(s.alpha > 0 && s.alpha < 1))
-    throw std::invalid_argument("alpha must be in (0, 1), got " + std::to_string(s.alpha));
-  if (s.out.empty()) throw std::invalid_argument("out must not be empty");
-  // Output names: plain file names, none the same as another output of the run (the figures are
-  // *.png; the table is the report's name with .txt).
+// Output names: plain file names, none the same as another output of the run (the figures are
+// *.png; the table is the report's name with .txt).
+void validate_outputs(const Scene& s) {
   if (const std::string why = output_name_problem(s.report); !why.empty())
     throw std::invalid_argument("outputs.report: \"" + printable(s.report) + "\" " + why);
   const std::string table = report_table_name(s.report);
@@ -124,7 +110,9 @@ void validate(const Scene& s) {
       throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" would collide with the figures (*.png)");
   }
   if (s.cor_table) validate_cor_table(s);
-  if (s.name.empty()) throw std::invalid_argument("name must not be empty");
+}
+
+void validate_bounce(const Scene& s) {
   if (s.bounce.enabled) {
     validate(s.bounce);
     for (std::size_t i = 0; i < s.bounce.variants.size(); ++i)
@@ -135,49 +123,76 @@ void validate(const Scene& s) {
   }
   if (s.bounce.enabled && !s.mesh && s.bounce.omega != Vec3::Zero())
     throw std::invalid_argument("bounce: Omega is for mesh bodies; the sphere's variants start without spin (Sec. V)");
+}
+
+// A mesh body: explicit bodies x rotations, single impacts or bounce sequences.
+void validate_mesh_run(const Scene& s) {
+  if (s.mesh->file.empty()) throw std::invalid_argument("mesh file must not be empty");
+  if (s.ensemble.mode != Mode::explicit_spheres)
+    throw std::invalid_argument("a mesh body needs mode explicit (explicit bodies x rotations), got " +
+                                std::string(to_string(s.ensemble.mode)));
+  if (s.ensemble.impact.enabled == s.bounce.enabled)
+    throw std::invalid_argument("a mesh body runs single impacts or bounce sequences: it needs an impact or a bounce "
+                                "experiment");
+  if (s.bounce.enabled && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
+    throw std::invalid_argument("a mesh body bounces with its orientation carried by the free rotation: variants must "
+                                "be \"dynamic\" only");
+  // Standard errors between bodies (batch means) need two rotations of each: refused before
+  // the run, not found after it.
+  const auto K = s.ensemble.spheres, n = s.ensemble.drops;
+  if (s.ensemble.impact.enabled && K >= 2 && n / K < 2)
+    throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over ensemble.spheres = " +
+                                std::to_string(K) + " bodies is " + std::to_string(n / K) +
+                                " rotation per body; the standard errors between bodies need at least 2 (drops >= " +
+                                std::to_string(2 * K) + ", or fewer --spheres)");
+}
+
+// Unequal radii on a sphere: their exact sampler, contacts only.
+void validate_radii_run(const Scene& s) {
+  // As the scene file checks it, also after --radius: every level (the lognormal median) below R.
+  const auto& d = s.radii->radii;
+  const double R = s.ensemble.sphere.radius;
+  const double top = d.kind == RadiusDistribution::Kind::levels
+                         ? *std::max_element(d.levels.begin(), d.levels.end())
+                         : d.kind == RadiusDistribution::Kind::lognormal ? d.median : d.radius;
+  if (!(top < R))
+    throw std::invalid_argument("asperity radii " + d.describe() + " must be smaller than radius = " + detail::num(R) + " m");
+  if (s.ensemble.mode != Mode::sampled)
+    throw std::invalid_argument("unequal asperity radii on a sphere need mode sampled (their exact sampler), got " +
+                                std::string(to_string(s.ensemble.mode)));
+  if (s.ensemble.impact.enabled || s.bounce.enabled)
+    throw std::invalid_argument("unequal asperity radii on a sphere are analysed as contacts only (no impacts)");
+  const auto B = s.radii->screen_bodies, n = s.ensemble.drops;
+  if (d.kind == RadiusDistribution::Kind::lognormal && B >= 2 && n / B < 2)
+    throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over screening.bodies = " +
+                                std::to_string(B) + " (lognormal radii: r_x from rotations of the screened bodies) is " +
+                                std::to_string(n / B) + " rotation per body; the standard errors between bodies need "
+                                "at least 2 (drops >= " + std::to_string(2 * B) + ")");
+}
+
+}  // namespace
+
+void validate(const Scene& s) {
+  if (s.mesh) {
+    // A mesh body's size is its mesh x scale (check_scene_inputs, run.hpp, checks the asperity
+    // radius against it): the sphere radius is unused and must not refuse the asperity radius.
+    EnsembleConfig e = s.ensemble;
+    e.sphere.radius = std::max(e.sphere.radius, 2.0 * e.sphere.asperity_radius);
+    validate(e);
+  } else {
+    validate(s.ensemble);
+  }
+  if (!(s.alpha > 0 && s.alpha < 1))
+    throw std::invalid_argument("alpha must be in (0, 1), got " + std::to_string(s.alpha));
+  if (s.out.empty()) throw std::invalid_argument("out must not be empty");
+  validate_outputs(s);
+  if (s.name.empty()) throw std::invalid_argument("name must not be empty");
+  validate_bounce(s);
   // Mesh bodies and unequal radii are the runs of body_experiments.hpp (also after command-line
   // overrides of a scene file): only the ensembles and experiments those runs have.
   if (s.radii) validate(s.radii->radii);
-  if (s.mesh) {
-    if (s.mesh->file.empty()) throw std::invalid_argument("mesh file must not be empty");
-    if (s.ensemble.mode != Mode::explicit_spheres)
-      throw std::invalid_argument("a mesh body needs mode explicit (explicit bodies x rotations), got " +
-                                  std::string(to_string(s.ensemble.mode)));
-    if (s.ensemble.impact.enabled == s.bounce.enabled)
-      throw std::invalid_argument("a mesh body runs single impacts or bounce sequences: it needs an impact or a bounce "
-                                  "experiment");
-    if (s.bounce.enabled && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
-      throw std::invalid_argument("a mesh body bounces with its orientation carried by the free rotation: variants must "
-                                  "be \"dynamic\" only");
-    // Standard errors between bodies (batch means) need two rotations of each: refused before
-    // the run, not found after it.
-    const auto K = s.ensemble.spheres, n = s.ensemble.drops;
-    if (s.ensemble.impact.enabled && K >= 2 && n / K < 2)
-      throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over ensemble.spheres = " +
-                                  std::to_string(K) + " bodies is " + std::to_string(n / K) +
-                                  " rotation per body; the standard errors between bodies need at least 2 (drops >= " +
-                                  std::to_string(2 * K) + ", or fewer --spheres)");
-  } else if (s.radii) {
-    // As the scene file checks it, also after --radius: every level (the lognormal median) below R.
-    const auto& d = s.radii->radii;
-    const double R = s.ensemble.sphere.radius;
-    const double top = d.kind == RadiusDistribution::Kind::levels
-                           ? *std::max_element(d.levels.begin(), d.levels.end())
-                           : d.kind == RadiusDistribution::Kind::lognormal ? d.median : d.radius;
-    if (!(top < R))
-      throw std::invalid_argument("asperity radii " + d.describe() + " must be smaller than radius = " + detail::num(R) + " m");
-    if (s.ensemble.mode != Mode::sampled)
-      throw std::invalid_argument("unequal asperity radii on a sphere need mode sampled (their exact sampler), got " +
-                                  std::string(to_string(s.ensemble.mode)));
-    if (s.ensemble.impact.enabled || s.bounce.enabled)
-      throw std::invalid_argument("unequal asperity radii on a sphere are analysed as contacts only (no impacts)");
-    const auto B = s.radii->screen_bodies, n = s.ensemble.drops;
-    if (d.kind == RadiusDistribution::Kind::lognormal && B >= 2 && n / B < 2)
-      throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over screening.bodies = " +
-                                  std::to_string(B) + " (lognormal radii: r_x from rotations of the screened bodies) is " +
-                                  std::to_string(n / B) + " rotation per body; the standard errors between bodies need "
-                                  "at least 2 (drops >= " + std::to_string(2 * B) + ")");
-  }
+  if (s.mesh) validate_mesh_run(s);
+  else if (s.radii) validate_radii_run(s);
 }
 
 }  // namespace asperity

@@ -954,13 +954,10 @@ Scene load_scene(const std::filesystem::path& file) {
   return s;
 }
 
-std::string to_toml(const Scene& s) {
-  const auto& e = s.ensemble;
-  const auto& x = e.impact;
-  std::ostringstream os;
-  os << "# asperity scene (README \"Scenes\")\n";
-  os << "format = " << kSceneFormatVersion << "\n";
-  os << "name = " << quote(s.name) << "\n\n";
+namespace {
+
+// One writer per table of to_toml, in the order of the file.
+void write_body(std::ostream& os, const Scene& s) {
   if (s.mesh) {
     os << "[body]\nkind = \"mesh\"\nmesh = " << quote(s.mesh->file.string()) << "\nscale = " << num(s.mesh->scale) << "\n";
     if (!s.mesh->smooth.empty()) {
@@ -970,8 +967,11 @@ std::string to_toml(const Scene& s) {
     }
     os << "\n";
   } else {
-    os << "[body]\nkind = \"sphere\"\nradius = " << num(e.sphere.radius) << "\n\n";
+    os << "[body]\nkind = \"sphere\"\nradius = " << num(s.ensemble.sphere.radius) << "\n\n";
   }
+}
+
+void write_material(std::ostream& os, const ImpactExperiment& x) {
   os << "[material]\ndensity = " << num(x.density);
   if (const auto& t = x.tangential; t.model == TangentialLaw::Model::coulomb)
     os << "\ntangential = { model = \"coulomb\", mu = " << num(t.mu) << ", restitution = \"" << to_string(t.normal) << "\" }";
@@ -980,22 +980,32 @@ std::string to_toml(const Scene& s) {
   else
     os << "\neps_t = " << num(x.eps_t);
   os << "\nrestitution = { model = \"viscoelastic\", beta = " << num(x.beta) << " }\n\n";
+}
+
+std::string toml_list(const std::vector<double>& v) {
+  std::string t = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + num(v[i]);
+  return t + "]";
+}
+
+// [asperities] and, for unequal radii, [screening].
+void write_asperities(std::ostream& os, const Scene& s) {
+  const auto& e = s.ensemble;
   os << "[asperities]\ncount = " << e.sphere.asperities << "\n";
   if (!s.radii) {
     os << "radius = { distribution = \"fixed\", value = " << num(e.sphere.asperity_radius) << " }\n\n";
   } else if (const auto& d = s.radii->radii; d.kind == RadiusDistribution::Kind::lognormal) {
     os << "radius = { distribution = \"lognormal\", median = " << num(d.median) << ", sigma = " << num(d.sigma) << " }\n\n";
   } else {
-    auto list = [](const std::vector<double>& v) {
-      std::string t = "[";
-      for (std::size_t i = 0; i < v.size(); ++i) t += (i ? ", " : "") + num(v[i]);
-      return t + "]";
-    };
-    os << "radius = { distribution = \"levels\", radii = " << list(d.levels) << ", fractions = " << list(d.fractions)
-       << " }\n\n";
+    os << "radius = { distribution = \"levels\", radii = " << toml_list(d.levels) << ", fractions = "
+       << toml_list(d.fractions) << " }\n\n";
   }
   if (s.radii)
     os << "[screening]\nbodies = " << s.radii->screen_bodies << "\ndirections = " << s.radii->screen_directions << "\n\n";
+}
+
+void write_ensemble(std::ostream& os, const Scene& s) {
+  const auto& e = s.ensemble;
   // A scene that named a mode by its earlier name is written as it was named (it runs as explicit).
   os << "[ensemble]\nmode = \"" << (s.legacy_mode.empty() ? to_string(e.mode) : std::string_view(s.legacy_mode))
      << "\"\ndrops = " << e.drops << "\n";
@@ -1012,53 +1022,81 @@ std::string to_toml(const Scene& s) {
     os << e.seed;
   os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::sampled ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
      << e.threads << "\n\n";
+}
+
+void write_bounce(std::ostream& os, const BounceExperiment& b, bool mesh) {
+  os << "[experiment]\nkind = \"bounce\"\nspeed = " << num(b.speed) << "\nstop_speed = " << num(b.stop_speed)
+     << "\ngravity = " << num(b.gravity) << "\nsequences = " << b.sequences << "\nvariants = \"";
+  for (std::size_t i = 0; i < b.variants.size(); ++i) os << (i ? "," : "") << to_string(b.variants[i]);
+  os << "\"\n";
+  if (mesh) os << "Omega = [" << num(b.omega.x()) << ", " << num(b.omega.y()) << ", " << num(b.omega.z()) << "]\n";
+  if (b.windows != BounceExperiment{}.windows) {
+    os << "speed_windows = [";
+    for (std::size_t i = 0; i < b.windows.size(); ++i) os << (i ? ", " : "") << "[" << num(b.windows[i].first) << ", " << num(b.windows[i].second) << "]";
+    os << "]\n";
+  }
+  if (b.impact_numbers != BounceExperiment{}.impact_numbers) {
+    os << "impact_groups = [";
+    for (std::size_t i = 0; i < b.impact_numbers.size(); ++i) os << (i ? ", " : "") << b.impact_numbers[i];
+    os << "]\n";
+  }
+  os << "\n";
+}
+
+void write_experiment(std::ostream& os, const Scene& s) {
+  const auto& x = s.ensemble.impact;
   if (s.bounce.enabled) {
-    const auto& b = s.bounce;
-    os << "[experiment]\nkind = \"bounce\"\nspeed = " << num(b.speed) << "\nstop_speed = " << num(b.stop_speed)
-       << "\ngravity = " << num(b.gravity) << "\nsequences = " << b.sequences << "\nvariants = \"";
-    for (std::size_t i = 0; i < b.variants.size(); ++i) os << (i ? "," : "") << to_string(b.variants[i]);
-    os << "\"\n";
-    if (s.mesh) os << "Omega = [" << num(b.omega.x()) << ", " << num(b.omega.y()) << ", " << num(b.omega.z()) << "]\n";
-    if (b.windows != BounceExperiment{}.windows) {
-      os << "speed_windows = [";
-      for (std::size_t i = 0; i < b.windows.size(); ++i) os << (i ? ", " : "") << "[" << num(b.windows[i].first) << ", " << num(b.windows[i].second) << "]";
-      os << "]\n";
-    }
-    if (b.impact_numbers != BounceExperiment{}.impact_numbers) {
-      os << "impact_groups = [";
-      for (std::size_t i = 0; i < b.impact_numbers.size(); ++i) os << (i ? ", " : "") << b.impact_numbers[i];
-      os << "]\n";
-    }
-    os << "\n";
+    write_bounce(os, s.bounce, s.mesh.has_value());
   } else if (x.enabled) {
     os << "[experiment]\nkind = \"impact\"\nV = [0.0, 0.0, " << num(-x.speed) << "]\nOmega = [" << num(x.omega.x())
        << ", " << num(x.omega.y()) << ", " << num(x.omega.z()) << "]\n\n";
   } else {
     os << "[experiment]\nkind = \"contact\"\n\n";
   }
+}
+
+// [outputs.cor_table]: written back only when the scene asks for a table.
+void write_cor_table_section(std::ostream& os, const CorTableScene& c) {
+  os << "\n[outputs.cor_table]\nfile = " << quote(c.file) << "\n";
+  if (!c.speeds.empty()) {
+    os << "speeds = [";
+    for (std::size_t i = 0; i < c.speeds.size(); ++i) os << (i ? ", " : "") << num(c.speeds[i]);
+    os << "]\n";
+  }
+  os << "probabilities = " << c.probabilities << "\ndrops = " << c.drops << "\n";
+  if (!c.spins.empty()) {
+    os << "spins = [";
+    for (std::size_t i = 0; i < c.spins.size(); ++i) os << (i ? ", " : "") << num(c.spins[i]);
+    os << "]\n";
+  }
+  if (c.omega_bands > 0) os << "omega_bands = " << c.omega_bands << "\n";
+}
+
+void write_outputs(std::ostream& os, const Scene& s) {
   os << "[outputs]\ncontact = " << (s.contact_stats ? "true" : "false") << "\n";
-  if (x.enabled || !s.restitution_stats) os << "restitution = " << (s.restitution_stats ? "true" : "false") << "\n";
+  if (s.ensemble.impact.enabled || !s.restitution_stats)
+    os << "restitution = " << (s.restitution_stats ? "true" : "false") << "\n";
   os << "plots = " << (s.plots ? "true" : "false") << "\nalpha = " << num(s.alpha) << "\ndir = " << quote(s.out.string())
      << "\nreport = " << quote(s.report) << "\n";
   if (s.mesh && !s.mesh->export_ply.empty())
     os << "export_ply = " << quote(s.mesh->export_ply) << "\nexport_style = \""
        << (s.mesh->export_points ? "points" : "spheres") << "\"\n";
-  if (s.cor_table) {
-    const CorTableScene& c = *s.cor_table;
-    os << "\n[outputs.cor_table]\nfile = " << quote(c.file) << "\n";
-    if (!c.speeds.empty()) {
-      os << "speeds = [";
-      for (std::size_t i = 0; i < c.speeds.size(); ++i) os << (i ? ", " : "") << num(c.speeds[i]);
-      os << "]\n";
-    }
-    os << "probabilities = " << c.probabilities << "\ndrops = " << c.drops << "\n";
-    if (!c.spins.empty()) {
-      os << "spins = [";
-      for (std::size_t i = 0; i < c.spins.size(); ++i) os << (i ? ", " : "") << num(c.spins[i]);
-      os << "]\n";
-    }
-    if (c.omega_bands > 0) os << "omega_bands = " << c.omega_bands << "\n";
-  }
+  if (s.cor_table) write_cor_table_section(os, *s.cor_table);
+}
+
+}  // namespace
+
+std::string to_toml(const Scene& s) {
+  std::ostringstream os;
+  os << "# asperity scene (README \"Scenes\")\n";
+  os << "format = " << kSceneFormatVersion << "\n";
+  os << "name = " << quote(s.name) << "\n\n";
+  write_body(os, s);
+  write_material(os, s.ensemble.impact);
+  write_asperities(os, s);
+  write_ensemble(os, s);
+  write_experiment(os, s);
+  write_outputs(os, s);
   return os.str();
 }
 

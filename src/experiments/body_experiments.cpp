@@ -104,12 +104,12 @@ struct ScreeningPool {
 
 bool decisive_rejection(const std::vector<LawCheck>& tests) {
   for (const auto& t : tests)
-    if (t.decisive && t.verdict == Verdict::reject) return true;
+    if (rejects(t)) return true;
   return false;
 }
 std::size_t decisive_skipped(const std::vector<LawCheck>& tests) {
   return static_cast<std::size_t>(
-      std::count_if(tests.begin(), tests.end(), [](const LawCheck& t) { return t.decisive && t.verdict == Verdict::skipped; }));
+      std::count_if(tests.begin(), tests.end(), [](const LawCheck& t) { return unresolved(t); }));
 }
 bool RadiiReport::rejected() const { return decisive_rejection(tests); }
 

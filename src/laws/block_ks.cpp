@@ -155,11 +155,11 @@ std::vector<BlockKsResult> block_ks_tests(const BlockBins& b, std::span<const Cd
   }
   for (auto& r : res) {
     if (r.p <= alpha)
-      r.verdict = "reject";
+      r.verdict = Verdict::reject;
     else if (1.0 / double(r.replicates + 1) >= alpha)
-      r.verdict = "undecided";
+      r.verdict = Verdict::undecided;
     else
-      r.verdict = "accept";
+      r.verdict = Verdict::accept;
   }
   return res;
 }

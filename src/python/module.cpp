@@ -345,13 +345,8 @@ ImpactScene impact_scene(std::uint64_t n, double R, double a, double speed, doub
   return s;
 }
 
-}  // namespace
-
-PYBIND11_MODULE(_asperity, m) {
-  m.doc() = "asperity: explicit-geometry contacts and restitution of rough particles (C++ library bindings)";
-  m.attr("__version__") = ASPERITY_VERSION;
-
-  // -- scenes and runs
+// One function per group of bindings, in the order the module defines them.
+void bind_scenes_and_runs(py::module_& m) {
   m.def("presets", &preset_names, "Names of the built-in preset scenes.");
   m.def("preset_text", [](const std::string& name) { return std::string(preset_text(name)); }, py::arg("name"),
         "The TOML text of a preset scene.");
@@ -369,8 +364,9 @@ arrays: None (default) adds report["arrays"] (per-drop numpy arrays r_x, r_y, r_
   same seed (bit-identical), which costs a second pass over the ensemble.
 The GIL is released while the run computes; Ctrl-C raises KeyboardInterrupt. Figures and files
 of the scene's outputs are written as by the CLI; the report file is not.)doc");
+}
 
-  // -- rough spheres, contact queries
+void bind_spheres(py::module_& m) {
   py::class_<PySphere, std::shared_ptr<PySphere>>(m, "RoughSphere", "An explicit rough sphere (core/geometry.hpp).")
       .def_property_readonly("asperities", [](const PySphere& s) { return s.body.params.asperities; })
       .def_property_readonly("radius", [](const PySphere& s) { return s.body.params.radius; })
@@ -413,6 +409,9 @@ of the scene's outputs are written as by the CLI; the report file is not.)doc");
       },
       py::arg("asperities") = 100000, py::arg("radius") = 3e-3, py::arg("asperity_radius") = 6.5e-7, py::arg("seed") = 1,
       py::arg("sphere_id") = 0, "N asperity centres uniform on the sphere of radius R, a pure function of (seed, sphere_id).");
+}
+
+void bind_queries(py::module_& m) {
   py::class_<PyQuery, std::shared_ptr<PyQuery>>(m, "ContactQuery")
       .def_property_readonly("backend", [](const PyQuery& q) { return std::string(to_string(q.index->backend())); })
       .def_property_readonly("memory_bytes", [](const PyQuery& q) { return q.index->memory_bytes(); })
@@ -477,8 +476,9 @@ of the scene's outputs are written as by the CLI; the report file is not.)doc");
         return vectors_to_numpy(d, single);
       },
       py::arg("q"), "The world's down direction in the body frame of bodies rotated by unit quaternions (w, x, y, z).");
+}
 
-  // -- restitution models and the impulse
+void bind_restitution(py::module_& m) {
   py::class_<Restitution, std::shared_ptr<Restitution>>(m, "Restitution", "A microscopic eps_n(v) model (core/restitution.hpp).")
       .def_property_readonly("name", &Restitution::name)
       .def(
@@ -504,6 +504,9 @@ of the scene's outputs are written as by the CLI; the report file is not.)doc");
         return constant_restitution(e);
       },
       py::arg("e"), "eps_n = e at every speed.");
+}
+
+void bind_impulse(py::module_& m) {
   m.def(
       "solve_impact",
       [](double mass, const py::handle& inertia, const py::handle& V, const py::handle& Omega, const py::handle& r,
@@ -574,8 +577,9 @@ of the scene's outputs are written as by the CLI; the report file is not.)doc");
 (broadcast); inertia a number (J = inertia x identity) or a 3x3 world-frame tensor; eps_n a number or
 a model (asperity.pade14()). Returns a dict of P, V_after, Omega_after, eps, eps_n, v_n, impact; rows
 without an impact (v_n >= 0) are NaN with impact False.)doc");
+}
 
-  // -- laws
+void bind_laws(py::module_& m) {
   py::class_<Law>(m, "Law", "A one-dimensional law with pdf and cdf (laws/theory.hpp).")
       .def_readonly("name", &Law::name)
       .def_readonly("description", &Law::description)
@@ -613,8 +617,9 @@ without an impact (v_n >= 0) are NaN with impact False.)doc");
   ASPERITY_IMPACT_LAW(eq33_printed, "Eq. 33 as printed: law of Omega'_x [rad/s].");
   ASPERITY_IMPACT_LAW(eq33_corrected, "Eq. 33 corrected: law of Omega'_x [rad/s].");
 #undef ASPERITY_IMPACT_LAW
+}
 
-  // -- restitution tables
+void bind_tables(py::module_& m) {
   m.def(
       "cor_table",
       [](const py::handle& scene, const py::object& speeds, std::size_t probabilities, const py::object& drops,
@@ -681,4 +686,19 @@ with path, writes path (CSV) and the .json next to it (files lists them). spins 
 Omega = (spin, 0, 0)) and/or omega_bands (Omega'_x quantiles per eps band, for joint draws) make a
 format-2 table: quantiles then has shape (spins, speeds, p) and omega_band_quantiles
 (spins, speeds, bands, p).)doc");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_asperity, m) {
+  m.doc() = "asperity: explicit-geometry contacts and restitution of rough particles (C++ library bindings)";
+  m.attr("__version__") = ASPERITY_VERSION;
+
+  bind_scenes_and_runs(m);
+  bind_spheres(m);
+  bind_queries(m);
+  bind_restitution(m);
+  bind_impulse(m);
+  bind_laws(m);
+  bind_tables(m);
 }

@@ -158,7 +158,7 @@ TEST(Explicit, CalibrationTrueLawRejectedAtAlpha) {
     c.seed = seed;
     c.backend = Backend::brute;
     const auto s = run_contact_ensemble(c);
-    rejected += block_ks_tests(bin_by_block(s.r_xy, 50, 256), laws, alpha, seed, 0)[0].verdict == "reject";
+    rejected += block_ks_tests(bin_by_block(s.r_xy, 50, 256), laws, alpha, seed, 0)[0].verdict == Verdict::reject;
   }
   const double rate = double(rejected) / double(seeds), se = std::sqrt(alpha * (1 - alpha) / double(seeds));
   std::printf("calibration (N = 50, 50 spheres x 100 rotations, %zu seeds): true law rejected at rate %.3f +- %.3f, "
@@ -177,9 +177,9 @@ TEST(Explicit, FewRotationsOfSmallSpheresRejectEq18) {
   EXPECT_GE(r.scene.ensemble.spheres, kMinDecisiveSpheres);
   const auto& eq18 = find(r.report, "r_x", "eq18");
   EXPECT_TRUE(eq18.decisive);
-  EXPECT_EQ(eq18.verdict, "reject") << "p = " << eq18.p;
-  EXPECT_EQ(find(r.report, "r_x", "exact-sphere").verdict, "accept");
-  EXPECT_EQ(find(r.report, "r_xy", "exact-sphere").verdict, "accept");
+  EXPECT_EQ(eq18.verdict, Verdict::reject) << "p = " << eq18.p;
+  EXPECT_EQ(find(r.report, "r_x", "exact-sphere").verdict, Verdict::accept);
+  EXPECT_EQ(find(r.report, "r_xy", "exact-sphere").verdict, Verdict::accept);
   EXPECT_TRUE(r.report.rejected());
 }
 
@@ -194,15 +194,15 @@ TEST(Fig3, ExplicitDefaultAcceptsTheLawsAndRejectsA5PercentWrongScale) {
   EXPECT_EQ(r.report.cross_check.agreed, r.report.cross_check.queries);
   for (const auto& t : r.report.tests)
     if (t.decisive) {
-      EXPECT_EQ(t.verdict, "accept") << t.quantity << " vs " << t.law << " p = " << t.p;
+      EXPECT_EQ(t.verdict, Verdict::accept) << t.quantity << " vs " << t.law << " p = " << t.p;
     }
   EXPECT_FALSE(r.report.rejected());
   const std::size_t K = r.scene.ensemble.spheres;
   const auto rxy = bin_by_block(r.samples.r_xy, K, 1024);
   const auto rx = bin_by_block(r.samples.r_x, K, 1024);
   const std::vector<Cdf> wrong_rxy{eq14_rxy(100000, 3e-3, 1.05).cdf}, wrong_rx{eq18_rx(100000, 3e-3, 1.05).cdf};
-  EXPECT_EQ(block_ks_tests(rxy, wrong_rxy, 0.01, 1, 10)[0].verdict, "reject");
-  EXPECT_EQ(block_ks_tests(rx, wrong_rx, 0.01, 1, 11)[0].verdict, "reject");
+  EXPECT_EQ(block_ks_tests(rxy, wrong_rxy, 0.01, 1, 10)[0].verdict, Verdict::reject);
+  EXPECT_EQ(block_ks_tests(rx, wrong_rx, 0.01, 1, 11)[0].verdict, Verdict::reject);
 }
 
 TEST(Explicit, OneSphereDecidesNothing) {
@@ -217,7 +217,7 @@ TEST(Explicit, OneSphereDecidesNothing) {
   const SceneRun r = run(s);
   for (const auto& t : r.report.tests)
     if (t.quantity != "core_contacts") {
-      EXPECT_EQ(t.verdict, "not-decisive") << t.quantity << " " << t.law;
+      EXPECT_EQ(t.verdict, Verdict::not_decisive) << t.quantity << " " << t.law;
       EXPECT_FALSE(t.decisive);
       EXPECT_NE(t.note.find("one sphere"), std::string::npos);
     }
@@ -239,7 +239,7 @@ TEST(Explicit, FewSpheresDecideNothing) {
   const SceneRun r = run(s);
   for (const auto& t : r.report.tests)
     if (t.statistic != "binomial") {
-      EXPECT_EQ(t.verdict, "not-decisive") << t.quantity << " " << t.law;
+      EXPECT_EQ(t.verdict, Verdict::not_decisive) << t.quantity << " " << t.law;
     }
   EXPECT_FALSE(r.report.rejected());
 }
@@ -294,12 +294,12 @@ TEST(Fig4, CorrectedLawsConfirmedPrintedLawsRejected) {
   const SceneRun r = run(s);
   ASSERT_EQ(r.samples.eps.size(), 200000u);
   EXPECT_EQ(r.samples.no_impacts, 0u);
-  EXPECT_EQ(find(r.report, "eps", "eq28-corrected").verdict, "accept") << find(r.report, "eps", "eq28-corrected").p;
-  EXPECT_EQ(find(r.report, "omega_x_after", "eq33-corrected").verdict, "accept");
+  EXPECT_EQ(find(r.report, "eps", "eq28-corrected").verdict, Verdict::accept) << find(r.report, "eps", "eq28-corrected").p;
+  EXPECT_EQ(find(r.report, "omega_x_after", "eq33-corrected").verdict, Verdict::accept);
   EXPECT_TRUE(find(r.report, "omega_x_after", "eq33-corrected").decisive);
-  EXPECT_EQ(find(r.report, "omega_x_after", "eq33-printed").verdict, "reject");
+  EXPECT_EQ(find(r.report, "omega_x_after", "eq33-printed").verdict, Verdict::reject);
   EXPECT_FALSE(find(r.report, "omega_x_after", "eq33-printed").decisive);
-  EXPECT_EQ(find(r.report, "eps", "eq28-printed").verdict, "reject");
+  EXPECT_EQ(find(r.report, "eps", "eq28-printed").verdict, Verdict::reject);
   EXPECT_FALSE(r.report.rejected());
   EXPECT_GT(r.report.eps_deficit.value, 0.0);
   EXPECT_LT(r.report.eps_deficit.value, 1e-3);
@@ -313,11 +313,11 @@ TEST(Fig5, PrintedEq33RejectedByTheDecisiveTest) {
   s.ensemble.drops = 200000;
   const SceneRun r = run(s);
   EXPECT_GE(r.scene.ensemble.spheres, kMinDecisiveSpheres);
-  EXPECT_EQ(find(r.report, "omega_x_after", "eq33-corrected").verdict, "accept");
-  EXPECT_EQ(find(r.report, "eps", "eq28-corrected").verdict, "accept");
+  EXPECT_EQ(find(r.report, "omega_x_after", "eq33-corrected").verdict, Verdict::accept);
+  EXPECT_EQ(find(r.report, "eps", "eq28-corrected").verdict, Verdict::accept);
   const auto& printed = find(r.report, "omega_x_after", "eq33-printed");
   EXPECT_EQ(printed.statistic, "KS-sphere-bootstrap");
-  EXPECT_EQ(printed.verdict, "reject");
+  EXPECT_EQ(printed.verdict, Verdict::reject);
   EXPECT_LE(printed.p, 0.01);
   EXPECT_FALSE(r.report.rejected());
 }

@@ -51,7 +51,7 @@ double rejection_rate(std::size_t seeds, std::size_t n, std::size_t blocks, doub
   for (std::size_t s = 1; s <= seeds; ++s) {
     const auto x = sample(s, n, blocks, shared);
     const auto b = bin_by_block(x, blocks ? blocks : n, grid, 256);
-    rej += block_ks_tests(b, laws, alpha, s, 0, 199, 999)[0].verdict == "reject";
+    rej += block_ks_tests(b, laws, alpha, s, 0, 199, 999)[0].verdict == Verdict::reject;
   }
   return double(rej) / double(seeds);
 }
@@ -119,11 +119,11 @@ TEST(BlockKs, UndecidedWhenTheSmallestPIsNotBelowAlpha) {
   const Cdf wrong = [](double t) { return std::clamp(t * t, 0.0, 1.0); };
   std::vector<Cdf> laws{wrong, kUniform};
   const auto r = block_ks_tests(b, laws, 1e-4, 1, 0, 199, 999);  // floor 1/1000 > alpha
-  EXPECT_EQ(r[0].verdict, "undecided");
-  EXPECT_EQ(r[1].verdict, "undecided");
+  EXPECT_EQ(r[0].verdict, Verdict::undecided);
+  EXPECT_EQ(r[1].verdict, Verdict::undecided);
   const auto r2 = block_ks_tests(b, laws, 0.01, 1, 0);
-  EXPECT_EQ(r2[0].verdict, "reject");
-  EXPECT_EQ(r2[1].verdict, "accept");
+  EXPECT_EQ(r2[0].verdict, Verdict::reject);
+  EXPECT_EQ(r2[1].verdict, Verdict::accept);
 }
 
 TEST(BlockKs, ReplicatesIdenticalForOneAndTwoThreads) {

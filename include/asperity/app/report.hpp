@@ -12,6 +12,7 @@
 #include "asperity/app/atomic_file.hpp"  // write_file_atomic, before it had a header of its own
 #include "asperity/app/scene.hpp"
 #include "asperity/laws/statistics.hpp"
+#include "asperity/laws/verdict.hpp"
 
 namespace asperity {
 
@@ -22,10 +23,13 @@ struct QuantityReport {
   Summary summary;   ///< SI units (metres)
 };
 
-struct TestReport {
-  std::string quantity;   ///< e.g. "r_xy"
-  std::string law;        ///< "eq14", "exact-sphere", "eq18"
-  std::string scope;      ///< "all" (every drop)
+/// One row of tests[]: a law against the sample of a quantity ("r_xy", ...; "core_contacts"), law
+/// "eq14", "exact-sphere", "eq18", ... decisive: counts towards the exit status. verdict: accept,
+/// reject, undecided (the bootstrap's smallest attainable p is not below alpha), not-decisive
+/// (explicit with fewer than kMinDecisiveSpheres spheres, e.g. one sphere: its own law, p assumes
+/// iid), skipped (the law could not be evaluated: D, p and predicted_mean NaN, the note says why).
+struct TestReport : LawTest {
+  std::string scope = "all";  ///< "all" (every drop)
   /// "KS" (iid drops: exact Kolmogorov p), "KS-sphere-bootstrap" (explicit: binned KS of all drops,
   /// p from a sphere-block bootstrap, laws/block_ks.hpp) or "binomial"
   std::string statistic;
@@ -34,13 +38,6 @@ struct TestReport {
   std::uint64_t n = 0;
   double predicted_mean = 0;  ///< mean of the quantity under the law (NaN if not applicable)
   bool iid = true;            ///< whether the p-value's iid assumption holds for these samples
-  bool decisive = true;       ///< counts towards the exit status
-  /// "accept", "reject", "undecided" (the bootstrap's smallest attainable p is not below alpha),
-  /// "not-decisive" (explicit with fewer than kMinDecisiveSpheres spheres, e.g. one sphere: its own
-  /// law, p assumes iid), "skipped" (the law could not be evaluated: D, p and predicted_mean NaN,
-  /// the note says why)
-  std::string verdict;
-  std::string note;
 };
 
 struct GeometryReport {

@@ -18,18 +18,15 @@
 
 namespace asperity {
 
-/// One KS test of a sample against a law, with its verdict at the run's alpha.
-struct LawCheck {
-  std::string quantity;     ///< "r_x", "r_xy", "eps"
-  std::string law;          ///< e.g. "exact-levels", "gauss-lambda", "gauss-lambda-eff", "gauss-lambda-top"
+/// One KS test of a sample against a law, with its verdict at the run's alpha (accept / reject /
+/// skipped: the law could not be evaluated). quantity: "r_x", "r_xy", "eps"; law: e.g.
+/// "exact-levels", "gauss-lambda", "gauss-lambda-eff", "gauss-lambda-top". decisive: an exact
+/// finite-N law, whose rejection fails the run (exit status 1); the paper's laws applied to other
+/// radii or bodies are measurements, not pass/fail.
+struct LawCheck : LawTest {
   double lambda = 0;        ///< areal density behind a Gaussian law [1/m^2] (NaN otherwise)
   KsResult ks;
   bool power_check = false; ///< a deliberately wrong law: must be rejected
-  /// An exact finite-N law: its rejection fails the run (exit status 1). The paper's laws applied
-  /// to other radii or bodies are measurements, not pass/fail.
-  bool decisive = false;
-  Verdict verdict = Verdict::skipped;  ///< accept / reject / skipped (the law could not be evaluated)
-  std::string note;
 };
 
 struct RadiiExperiment {

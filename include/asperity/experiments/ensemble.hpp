@@ -38,7 +38,7 @@ std::string legacy_mode_note(std::string_view legacy);
 
 /// KS-scale constant of the quenched deviation: one fixed sphere's orientation-averaged law of
 /// r_xy differs from the ensemble law by E sup_t |F_sphere(t) - F(t)| ~ kQuenchedKs / sqrt(N)
-/// (measured: bench/quenched_scale.cpp, bench/RESULTS.md "Quenched deviation").
+/// (measured: bench/quenched_scale.cpp, bench/RESULTS.md "Explicit design: quenched constant").
 inline constexpr double kQuenchedKs = 0.25;
 /// Fewest spheres of an automatic design: the sphere-block bootstrap of the decisive tests needs
 /// enough independent blocks to estimate the spread between spheres.

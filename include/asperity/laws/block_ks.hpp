@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "asperity/laws/statistics.hpp"
+#include "asperity/laws/verdict.hpp"
 
 namespace asperity {
 
@@ -57,7 +58,7 @@ struct BlockKsResult {
   double D = 0;               ///< binned KS distance of the pooled sample
   double p = 1;               ///< (1 + #{D* >= D}) / (B + 1)
   std::size_t replicates = 0; ///< B
-  std::string verdict;        ///< "accept", "reject", or "undecided" (1/(B+1) not below alpha)
+  Verdict verdict = Verdict::undecided;  ///< accept, reject, or undecided (1/(B+1) not below alpha)
 };
 
 /// Tests every law in `laws` against the pooled sample on one set of replicates (adaptive B, from

@@ -1,6 +1,7 @@
 #pragma once
 // The verdict of a statistical test on a law: one enum for every report (no strings compared by
 // hand). Its spelling in report.json and tables is to_string's.
+#include <string>
 #include <string_view>
 
 namespace asperity {
@@ -18,5 +19,23 @@ std::string_view to_string(Verdict v);
 
 /// accept or reject at level alpha; skipped for a NaN p.
 Verdict verdict_at(double p, double alpha);
+
+/// What every test of a sample against a law reports, whichever run made it: the sphere runs'
+/// rows (TestReport, app/report.hpp) and the radii and mesh-body runs' checks (LawCheck,
+/// experiments/body_experiments.hpp) extend it with their statistics.
+struct LawTest {
+  std::string quantity;               ///< e.g. "r_xy", "r_x", "eps", "omega_x_after", "core_contacts"
+  std::string law;                    ///< e.g. "eq14", "exact-sphere", "exact-levels", "gauss-lambda"
+  bool decisive = false;              ///< counts towards the exit status
+  Verdict verdict = Verdict::skipped;
+  std::string note;                   ///< how the p-value was made, or why the law was not tested
+};
+
+/// A decisive test rejected its law (the run exits 1).
+inline bool rejects(const LawTest& t) { return t.decisive && t.verdict == Verdict::reject; }
+/// A decisive test that could not be evaluated (skipped) or not decided (undecided): the run says so.
+inline bool unresolved(const LawTest& t) {
+  return t.decisive && (t.verdict == Verdict::skipped || t.verdict == Verdict::undecided);
+}
 
 }  // namespace asperity

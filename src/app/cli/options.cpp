@@ -16,8 +16,7 @@ namespace asperity::cli {
 
 namespace {
 
-constexpr std::uint64_t kMaxAsperities = (std::uint64_t{1} << 32) - 1;  // geometry.hpp: N < 2^32
-constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
+constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;  // ensemble.hpp (kMaxAsperities: geometry.hpp, the one N < 2^32 rule)
 
 bool digits(const std::string& t, std::size_t& i) {
   const std::size_t from = i;
