@@ -121,10 +121,10 @@ double LazySphere::lower_key(const Node& c, const Direction& q) {
   if (A > 0) {
     // |(A, dz)| <= 1: no overflow, so sqrt instead of the much slower std::hypot (its last-ulp
     // accuracy is far inside the 1e-13 margin).
+    // The concave f peaks at zs = dz / norm with f(zs) = norm; compared as dz against z norm (no
+    // division), the peak inside the cell bounds it by norm itself, else the nearer end does.
     const double norm = std::sqrt(A * A + dz * dz);
-    const double zs = dz / norm;  // unconstrained maximum of the concave f
-    ub = f(std::clamp(zs, c.z0, c.z1));
-    if (zs >= c.z0 && zs <= c.z1) ub = std::max(ub, norm);
+    ub = dz < c.z0 * norm ? f(c.z0) : dz > c.z1 * norm ? f(c.z1) : norm;
   } else {
     ub = std::max(f(c.z0), f(c.z1));  // convex: maximum at an end
   }
