@@ -176,13 +176,13 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress, const std::filesy
   return o;
 }
 
-SceneOutput run_bounce(const Scene& s, std::ostream* log, const std::filesystem::path& dir) {
+SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* log, const std::filesystem::path& dir) {
   const auto& e = s.ensemble;
   SceneOutput o;
   auto t0 = Clock::now();
   auto bounce = s.bounce;
   bounce.alpha = s.alpha;  // the verdicts of the Eq. 2 bootstrap use the scene's level
-  const auto reports = run_bounce_experiment(e.sphere, bounce, e.seed, e.threads, log);
+  const auto reports = run_bounce_experiment(e.sphere, bounce, e.seed, e.threads, log, progress);
   const double seconds_bounce = since(t0);
   t0 = Clock::now();
   const auto comparisons = compare_bounce_variants(reports);
@@ -425,7 +425,7 @@ SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostr
     case RunKind::sphere: o = run_sphere(s, progress, into); break;
     case RunKind::radii: o = run_radii(s, progress, into); break;
     case RunKind::mesh: o = run_mesh(s, progress, into); break;
-    case RunKind::bounce: o = run_bounce(s, log, into); break;
+    case RunKind::bounce: o = run_bounce(s, progress, log, into); break;
     case RunKind::mesh_bounce: o = run_mesh_bounce(s, progress, into); break;
   }
   o.kind = run_kind(s);

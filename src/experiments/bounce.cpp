@@ -224,7 +224,7 @@ Flight ballistic_flight(double h0, double vz, double D, double g) {
 }
 
 BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b, BounceVariant v, std::uint64_t seed,
-                          int threads) {
+                          int threads, const Progress& progress) {
   validate(sphere);
   validate(b);
   if (b.omega != Vec3::Zero())
@@ -244,7 +244,7 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   s.sequences = b.sequences;
   s.sphere = sphere;
   s.first_speed = b.speed;
-  const std::uint64_t chunk = 4096;
+  const std::uint64_t chunk = kBounceBlock;
   std::vector<SequenceOut> outs(static_cast<std::size_t>(std::min(chunk, b.sequences)));
   const int nt = threads > 0 ? threads : omp_get_max_threads();
   for (std::uint64_t start = 0; start < b.sequences; start += chunk) {
@@ -273,6 +273,8 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
       s.no_impacts += o.cut ? 1 : 0;
       s.cells += o.cells, s.centres += o.centres;
     }
+    // Outside the parallel region: an exception from the callback leaves through here.
+    if (progress) progress(start + static_cast<std::uint64_t>(m), b.sequences);
   }
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
@@ -447,11 +449,16 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
 }
 
 std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& sphere, const BounceExperiment& b,
-                                                       std::uint64_t seed, int threads, std::ostream* log) {
+                                                       std::uint64_t seed, int threads, std::ostream* log,
+                                                       const Progress& progress) {
   std::vector<BounceVariantReport> out;
+  const std::uint64_t total = b.sequences * b.variants.size();
   for (auto v : b.variants) {
     const auto t0 = Clock::now();
-    const BounceSamples s = run_bounces(sphere, b, v, seed, threads);
+    const std::uint64_t offset = b.sequences * out.size();
+    Progress in_variant;
+    if (progress) in_variant = [&](std::uint64_t done, std::uint64_t) { progress(offset + done, total); };
+    const BounceSamples s = run_bounces(sphere, b, v, seed, threads, in_variant);
     out.push_back(analyse_bounces(s, b, seed));
     if (log)
       *log << "bounce " << to_string(v) << ": " << s.sequences << " sequences, " << s.eps.size() << " impacts, run "
