@@ -59,6 +59,16 @@ CorTableSpec cor_table_spec(const Scene& s, std::size_t speeds) {
   return c;
 }
 
+CorTableSpec cor_table_spec(const Scene& s, const CorTableScene& c) {
+  CorTableSpec spec = cor_table_spec(s);
+  if (!c.speeds.empty()) spec.speeds = c.speeds;
+  spec.probabilities = c.probabilities;
+  spec.drops = c.drops;
+  spec.spins = c.spins;
+  spec.omega_bands = c.omega_bands;
+  return spec;
+}
+
 void validate(const CorTableSpec& c) {
   validate(c.sphere);
   if (c.speeds.empty()) bad("speeds", "[]", "needs at least one speed");
@@ -70,8 +80,79 @@ void validate(const CorTableSpec& c) {
   if (c.probabilities < 2 || c.probabilities > 100001)
     bad("probabilities", std::to_string(c.probabilities), "must be in [2, 100001]");
   if (c.drops < 3) bad("drops", std::to_string(c.drops), "must be >= 3");
+  for (std::size_t i = 0; i < c.spins.size(); ++i) {
+    const double w = c.spins[i];
+    if (!std::isfinite(w) || std::abs(w) > 1e6) bad("spins[" + std::to_string(i) + "]", num(w), "must be finite, |spin| <= 1e6 rad/s");
+    if (i > 0 && !(w > c.spins[i - 1])) bad("spins[" + std::to_string(i) + "]", num(w), "spins must be strictly ascending");
+  }
+  if (c.spins.size() > 1000) bad("spins", std::to_string(c.spins.size()) + " values", "at most 1000 spins");
+  if (c.omega_bands > 1000 || (c.omega_bands > 0 && 2 * c.omega_bands > c.drops))
+    bad("omega_bands", std::to_string(c.omega_bands), "must be in [0, 1000] and at most drops / 2");
   if (!(c.impact.beta > 0) || !std::isfinite(c.impact.beta)) bad("beta", num(c.impact.beta), "must be finite and > 0");
 }
+
+namespace {
+
+// Omega'_x quantiles of the drops in each of `bands` equiprobable bands of eps (ranked by eps,
+// ties by drop index so the bands do not depend on the sort).
+std::vector<std::vector<double>> omega_band_quantiles(const ContactSamples& s, std::size_t bands,
+                                                      const std::vector<double>& probabilities) {
+  std::vector<std::size_t> order(s.eps.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s.eps[a] < s.eps[b] || (s.eps[a] == s.eps[b] && a < b); });
+  std::vector<std::vector<double>> out;
+  const std::size_t n = order.size();
+  for (std::size_t b = 0; b < bands; ++b) {
+    std::vector<double> w;
+    for (std::size_t r = b * n / bands; r < (b + 1) * n / bands; ++r) w.push_back(s.omega_x_after[order[r]]);
+    std::sort(w.begin(), w.end());
+    std::vector<double> q;
+    for (const double p : probabilities) q.push_back(quantile_sorted(w, p));
+    out.push_back(std::move(q));
+  }
+  return out;
+}
+
+// One (spin, speed) row: its drops, quantiles, moments and Eq. 2 fit. `where` names it in errors.
+CorTableRow make_row(const CorTableSpec& spec, const Vec3& omega, double speed, const std::vector<double>& probabilities,
+                     const Progress& progress, const std::string& where) {
+  EnsembleConfig c;
+  c.sphere = spec.sphere;
+  c.mode = Mode::sampled;  // the exact finite-N law of the lowest asperity (the header says so)
+  c.drops = spec.drops;
+  c.seed = spec.seed;
+  c.threads = spec.threads;
+  c.impact = spec.impact;
+  c.impact.enabled = true;
+  c.impact.speed = speed;
+  c.impact.omega = omega;
+  ContactSamples s = run_contact_ensemble(c, progress);
+  CorTableRow row;
+  row.spin = omega.x();
+  row.speed = speed;
+  row.samples = s.eps.size();
+  row.eps_n = (*viscoelastic_pade14(spec.impact.beta))(speed);
+  row.core_contacts = static_cast<std::uint64_t>(std::count(s.eps_core.begin(), s.eps_core.end(), std::uint8_t{1}));
+  if (s.eps.size() < std::max<std::size_t>(2, 2 * spec.omega_bands)) bad(where, num(speed), "too few drops approached the plate");
+  if (spec.omega_bands > 0) row.omega_x_band_quantiles = omega_band_quantiles(s, spec.omega_bands, probabilities);
+  std::sort(s.eps.begin(), s.eps.end());
+  std::sort(s.omega_x_after.begin(), s.omega_x_after.end());
+  for (const double p : probabilities) {
+    row.quantiles.push_back(quantile_sorted(s.eps, p));
+    row.omega_x_quantiles.push_back(quantile_sorted(s.omega_x_after, p));
+  }
+  std::tie(row.mean, row.std) = mean_std(s.eps);
+  std::tie(row.omega_x_mean, row.omega_x_std) = mean_std(s.omega_x_after);
+  try {
+    row.fit = fit_asymmetric_laplace_sorted(s.eps);
+    row.fitted = true;
+  } catch (const std::exception& e) {
+    row.fit_note = e.what();
+  }
+  return row;
+}
+
+}  // namespace
 
 CorTable make_cor_table(const CorTableSpec& spec, const Progress& progress) {
   validate(spec);
@@ -79,66 +160,62 @@ CorTable make_cor_table(const CorTableSpec& spec, const Progress& progress) {
   t.spec = spec;
   const std::size_t P = spec.probabilities;
   for (std::size_t j = 0; j < P; ++j) t.probabilities.push_back(static_cast<double>(j) / static_cast<double>(P - 1));
-  const auto eps_n = viscoelastic_pade14(spec.impact.beta);
-  const std::uint64_t total = spec.drops * spec.speeds.size();
-  for (std::size_t i = 0; i < spec.speeds.size(); ++i) {
-    EnsembleConfig c;
-    c.sphere = spec.sphere;
-    c.mode = Mode::sampled;  // the exact finite-N law of the lowest asperity (the header says so)
-    c.drops = spec.drops;
-    c.seed = spec.seed;
-    c.threads = spec.threads;
-    c.impact = spec.impact;
-    c.impact.enabled = true;
-    c.impact.speed = spec.speeds[i];
-    const std::uint64_t offset = spec.drops * i;
-    Progress p;
-    if (progress) p = [&](std::uint64_t done, std::uint64_t) { progress(offset + done, total); };
-    ContactSamples s = run_contact_ensemble(c, p);
-    // The ensemble reports from its thread 0 only, which may get no chunk of a small run: one
-    // report per speed from here, so progress (and a Python binding's Ctrl-C check) always runs.
-    if (progress) progress(offset + spec.drops, total);
-    CorTableRow row;
-    row.speed = spec.speeds[i];
-    row.samples = s.eps.size();
-    row.eps_n = (*eps_n)(row.speed);
-    row.core_contacts = static_cast<std::uint64_t>(std::count(s.eps_core.begin(), s.eps_core.end(), std::uint8_t{1}));
-    if (s.eps.empty()) bad("speeds[" + std::to_string(i) + "]", num(row.speed), "no drop approached the plate");
-    std::sort(s.eps.begin(), s.eps.end());
-    std::sort(s.omega_x_after.begin(), s.omega_x_after.end());
-    for (const double p : t.probabilities) {
-      row.quantiles.push_back(quantile_sorted(s.eps, p));
-      row.omega_x_quantiles.push_back(quantile_sorted(s.omega_x_after, p));
+  std::vector<Vec3> omegas;
+  if (spec.spins.empty()) omegas.push_back(spec.impact.omega);
+  for (const double w : spec.spins) omegas.push_back(Vec3(w, 0, 0));
+  const std::uint64_t total = spec.drops * spec.speeds.size() * omegas.size();
+  std::uint64_t offset = 0;
+  for (const Vec3& omega : omegas)
+    for (std::size_t i = 0; i < spec.speeds.size(); ++i) {
+      Progress p;
+      if (progress) p = [&](std::uint64_t done, std::uint64_t) { progress(offset + done, total); };
+      t.rows.push_back(make_row(spec, omega, spec.speeds[i], t.probabilities, p, "speeds[" + std::to_string(i) + "]"));
+      offset += spec.drops;
+      // The ensemble reports from its thread 0 only, which may get no chunk of a small run: one
+      // report per row from here, so progress (and a Python binding's Ctrl-C check) always runs.
+      if (progress) progress(offset, total);
     }
-    std::tie(row.mean, row.std) = mean_std(s.eps);
-    std::tie(row.omega_x_mean, row.omega_x_std) = mean_std(s.omega_x_after);
-    try {
-      row.fit = fit_asymmetric_laplace_sorted(s.eps);
-      row.fitted = true;
-    } catch (const std::exception& e) {
-      row.fit_note = e.what();
-    }
-    t.rows.push_back(std::move(row));
-  }
   return t;
 }
 
+namespace {
+
+void write_quantiles(std::ostream& o, const std::vector<double>& q) {
+  for (const double x : q) o << "," << num(x);
+  o << "\n";
+}
+
+}  // namespace
+
 std::string cor_table_csv(const CorTable& t) {
   std::ostringstream o;
-  o << "# asperity-cor-table format=" << kCorTableFormatVersion << "\n"
-    << "# eps quantiles: row = impact speed [m/s], column p = probability; sample eps by bilinear\n"
-    << "# interpolation in (speed, p) with a uniform u (include/asperity/cor_table.h). Header: the .json file.\n"
-    << "# N=" << t.spec.sphere.asperities << " R=" << num(t.spec.sphere.radius) << " a=" << num(t.spec.sphere.asperity_radius)
+  const int format = t.format();
+  o << "# asperity-cor-table format=" << format << "\n";
+  if (format == 1)
+    o << "# eps quantiles: row = impact speed [m/s], column p = probability; sample eps by bilinear\n"
+      << "# interpolation in (speed, p) with a uniform u (include/asperity/cor_table.h). Header: the .json file.\n";
+  else
+    o << "# eps quantiles per incoming spin Omega_x [rad/s] and impact speed [m/s], then Omega'_x quantiles per\n"
+      << "# eps band (omega_x:<b>); sample with include/asperity/cor_table.h. Header: the .json file.\n";
+  o << "# N=" << t.spec.sphere.asperities << " R=" << num(t.spec.sphere.radius) << " a=" << num(t.spec.sphere.asperity_radius)
     << " beta=" << num(t.spec.impact.beta) << " eps_t=" << num(t.spec.impact.eps_t) << " Omega=" << num(t.spec.impact.omega.x())
     << "," << num(t.spec.impact.omega.y()) << "," << num(t.spec.impact.omega.z()) << " seed=" << t.spec.seed
     << " drops=" << t.spec.drops << " version=" << ASPERITY_VERSION << "\n";
-  o << "speed_m_s";
+  o << (format == 1 ? "speed_m_s" : "spin_rad_s,speed_m_s,row");
   for (const double p : t.probabilities) o << ",p=" << num(p);
   o << "\n";
   for (const auto& r : t.rows) {
-    o << num(r.speed);
-    for (const double q : r.quantiles) o << "," << num(q);
-    o << "\n";
+    if (format == 1) {
+      o << num(r.speed);
+      write_quantiles(o, r.quantiles);
+      continue;
+    }
+    o << num(r.spin) << "," << num(r.speed) << ",eps";
+    write_quantiles(o, r.quantiles);
+    for (std::size_t b = 0; b < r.omega_x_band_quantiles.size(); ++b) {
+      o << num(r.spin) << "," << num(r.speed) << ",omega_x:" << b;
+      write_quantiles(o, r.omega_x_band_quantiles[b]);
+    }
   }
   return o.str();
 }
@@ -148,7 +225,7 @@ std::string cor_table_json(const CorTable& t) {
   const auto& s = t.spec;
   json j;
   j["format"] = "asperity-cor-table";
-  j["format_version"] = kCorTableFormatVersion;
+  j["format_version"] = t.format();
   j["tool"] = "asperity";
   j["version"] = ASPERITY_VERSION;
   j["quantity"] = "eps";
@@ -157,13 +234,20 @@ std::string cor_table_json(const CorTable& t) {
                    {"restitution", {{"model", "viscoelastic"}, {"beta", s.impact.beta}}}};
   j["Omega_rad_s"] = {s.impact.omega.x(), s.impact.omega.y(), s.impact.omega.z()};
   j["ensemble"] = {{"mode", "sampled"},
-                   {"method", "sampled from the exact finite-N law of the lowest asperity (no sphere is built)"},
+                   {"method", kCorTableEnsemble},
                    {"drops_per_speed", s.drops}, {"seed", s.seed}};
   j["speeds_m_s"] = s.speeds;
+  if (t.format() == kCorTableFormatVersionSpins) {
+    std::vector<double> spins;
+    for (const auto& r : t.rows)
+      if (spins.empty() || r.spin != spins.back()) spins.push_back(r.spin);
+    j["spins_rad_s"] = spins;  // incoming Omega = (spin, 0, 0); the scene's Omega when none were asked for
+    j["omega_bands"] = s.omega_bands;
+  }
   j["probabilities"] = t.probabilities;
   json rows = json::array();
   for (const auto& r : t.rows) {
-    json x = {{"speed_m_s", r.speed}, {"samples", r.samples}, {"core_contacts", r.core_contacts},
+    json x = {{"spin_rad_s", r.spin}, {"speed_m_s", r.speed}, {"samples", r.samples}, {"core_contacts", r.core_contacts},
               {"eps_n", r.eps_n}, {"mean", r.mean}, {"std", r.std},
               {"omega_x_after", {{"mean", r.omega_x_mean}, {"std", r.omega_x_std}, {"quantiles", r.omega_x_quantiles}}}};
     if (r.fitted)

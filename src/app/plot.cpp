@@ -214,43 +214,49 @@ constexpr Style kCurveStyles[] = {
     {"#CC79A7", "(3,6)"}, {"#E69F00", "(8,8)"}, {"#56B4E9", "(24,8)"},
 };
 
-std::string build_script(const HistogramFigure& fig, const fs::path& out) {
+// What the data blocks found: the x range and the largest/smallest values the panels must show.
+struct ScriptRanges {
+  double xa = 0, xb = 0;                                          ///< x range (scaled, increasing)
+  double ymax = 0;                                                ///< largest density + se
+  double ymin_pos = std::numeric_limits<double>::infinity();      ///< smallest density of a non-empty bin
+  double curve_max = 0;                                           ///< largest curve value inside [xa, xb]
+};
+
+// $hist: x, density, se, count per bin (scaled).
+void write_histogram_block(std::ostream& s, const HistogramFigure& fig, ScriptRanges& r) {
   const Histogram& h = fig.histogram;
   const double xs = fig.x_scale, ys = fig.y_scale;
-
-  std::ostringstream s;
-  s.imbue(std::locale::classic());
-  s << std::setprecision(17);
-
-  // ---- data ----
-  double ymax = 0, ymin_pos = std::numeric_limits<double>::infinity();
   s << "$hist << EOD\n";
   for (std::size_t i = 0; i < h.bins(); ++i) {
     const double d = h.density(i) * ys, e = h.density_se(i) * ys;
     if (!std::isfinite(d) || !std::isfinite(e))
       throw std::invalid_argument("write_histogram_png: density in bin " + std::to_string(i) + " is not finite");
     s << h.centre(i) * xs << ' ' << d << ' ' << e << ' ' << h.counts[i] << '\n';
-    ymax = std::max(ymax, d + e);
-    if (h.counts[i] > 0) ymin_pos = std::min(ymin_pos, d);
+    r.ymax = std::max(r.ymax, d + e);
+    if (h.counts[i] > 0) r.ymin_pos = std::min(r.ymin_pos, d);
   }
   s << "EOD\n";
-  double xa = h.lo * xs, xb = h.hi * xs;
-  if (xa > xb) std::swap(xa, xb);
-  double curve_max = 0;
+  r.xa = h.lo * xs, r.xb = h.hi * xs;
+  if (r.xa > r.xb) std::swap(r.xa, r.xb);
+}
+
+// $curve0, $curve1, ...: x, y per point (scaled).
+void write_curve_blocks(std::ostream& s, const HistogramFigure& fig, ScriptRanges& r) {
   for (std::size_t k = 0; k < fig.curves.size(); ++k) {
     const Curve& c = fig.curves[k];
     s << "$curve" << k << " << EOD\n";
     for (std::size_t i = 0; i < c.x.size(); ++i) {
-      const double x = c.x[i] * xs, y = c.y[i] * ys;
+      const double x = c.x[i] * fig.x_scale, y = c.y[i] * fig.y_scale;
       if (!std::isfinite(x) || !std::isfinite(y))
         throw std::invalid_argument("write_histogram_png: scaled curve \"" + c.label + "\" is not finite");
       s << x << ' ' << y << '\n';
-      if (x >= xa && x <= xb) curve_max = std::max(curve_max, y);
+      if (x >= r.xa && x <= r.xb) r.curve_max = std::max(r.curve_max, y);
     }
     s << "EOD\n";
   }
+}
 
-  // ---- common style ----
+void write_common_style(std::ostream& s, const HistogramFigure& fig, const fs::path& out, const ScriptRanges& r) {
   s << "set encoding utf8\n"
     << "set terminal pngcairo size 900,1000 enhanced font 'sans,12' linewidth 1.2 rounded\n"
     << "set output " << gp_path(out) << "\n"
@@ -262,53 +268,50 @@ std::string build_script(const HistogramFigure& fig, const fs::path& out) {
     << "set ytics in mirror scale 1.2,0.6\n"
     << "unset x2tics\nunset y2tics\n"
     << "set mxtics\n"
-    << "set xrange [" << xa << ":" << xb << "]\n"
+    << "set xrange [" << r.xa << ":" << r.xb << "]\n"
     << "set xlabel " << gp_text(fig.xlabel) << "\n"
     << "set ylabel " << gp_text(fig.ylabel) << " offset 0.5,0\n"
     << "set key top right reverse Left samplen 3.5 spacing 1.25 width 1 nobox\n"
     << "set style line 100 linecolor rgb '#E2E2E2' linewidth 0.8 dashtype solid\n"
     << "set lmargin 12\nset rmargin 4\n"
     << "set multiplot layout 2,1 title " << gp_text(fig.title) << " font 'sans,14'\n";
+}
 
-  // Legend entry for the data first, then the curves, then the data drawn on top without a title.
-  const std::string data_title =
-      fig.data_label + " (n = " + format_count(h.total) + ")";
-  auto plot_cmd = [&](bool log_panel) {
-    s << "plot NaN with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 title "
-      << gp_text(data_title);
-    for (std::size_t k = 0; k < fig.curves.size(); ++k) {
-      const Style& st = kCurveStyles[k % std::size(kCurveStyles)];
-      s << ", \\\n     $curve" << k << " using 1:"
-        << (log_panel ? "($2 > 0 ? $2 : NaN)" : "2")
-        << " with lines linewidth 2.2 linecolor rgb '" << st.colour << "' dashtype " << st.dash << " title "
-        << gp_text(fig.curves[k].label);
-    }
-    s << ", \\\n     $hist using 1:"
-      << (log_panel ? "($4 > 0 ? $2 : NaN):($2 - $3 > LOGFLOOR ? $2 - $3 : LOGFLOOR):($2 + $3)" : "2:3")
-      << " with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 notitle\n";
-  };
+// Legend entry for the data first, then the curves, then the data drawn on top without a title.
+void write_plot_command(std::ostream& s, const HistogramFigure& fig, bool log_panel) {
+  const std::string data_title = fig.data_label + " (n = " + format_count(fig.histogram.total) + ")";
+  s << "plot NaN with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 title "
+    << gp_text(data_title);
+  for (std::size_t k = 0; k < fig.curves.size(); ++k) {
+    const Style& st = kCurveStyles[k % std::size(kCurveStyles)];
+    s << ", \\\n     $curve" << k << " using 1:"
+      << (log_panel ? "($2 > 0 ? $2 : NaN)" : "2")
+      << " with lines linewidth 2.2 linecolor rgb '" << st.colour << "' dashtype " << st.dash << " title "
+      << gp_text(fig.curves[k].label);
+  }
+  s << ", \\\n     $hist using 1:"
+    << (log_panel ? "($4 > 0 ? $2 : NaN):($2 - $3 > LOGFLOOR ? $2 - $3 : LOGFLOOR):($2 + $3)" : "2:3")
+    << " with yerrorbars pointtype 7 pointsize 0.6 linecolor rgb '#000000' linewidth 1 notitle\n";
+}
 
-  // The data set the ranges; a curve may raise them by at most a factor 2 (a divergent or badly
-  // wrong curve must not squash the measurement).
-  curve_max = std::min(curve_max, 2.0 * ymax);
-
-  // ---- top: linear ----
-  // The legend sits in the top panel above everything plotted: leave headroom for its rows
-  // (~21 px each at 12 pt, in a plot area ~400 px high).
+// Top panel, linear. The legend sits in it above everything plotted: leave headroom for its rows
+// (~21 px each at 12 pt, in a plot area ~400 px high).
+void write_linear_panel(std::ostream& s, const HistogramFigure& fig, const ScriptRanges& r) {
   const double key_rows = 1.0 + static_cast<double>(fig.curves.size());
   const double key_frac = std::min(0.5, (21.0 * key_rows + 24.0) / 400.0);
-  const double ytop = std::max(ymax, curve_max) / (1.0 - key_frac);
+  const double ytop = std::max(r.ymax, r.curve_max) / (1.0 - key_frac);
   s << "set yrange [0:" << ytop << "]\n"
     << "set mytics\n"
     << "set format y '%g'\n"
     << "set grid noxtics noytics\n";
-  plot_cmd(false);
+  write_plot_command(s, fig, false);
+}
 
-  // ---- bottom: logarithmic ----
-  // Lower bound: the decade at or below a third of the smallest non-zero density, so the lowest
-  // point (a single count) sits clearly above the axis. The legend is not repeated here.
-  const double lo_decade = std::pow(10.0, std::floor(std::log10(ymin_pos / 3.0)));
-  const double hi_decade = std::max(std::pow(10.0, std::ceil(std::log10(std::max(ymax, curve_max) * 1.5))),
+// Bottom panel, logarithmic. Lower bound: the decade at or below a third of the smallest non-zero
+// density, so the lowest point (a single count) sits clearly above the axis. No legend here.
+void write_log_panel(std::ostream& s, const HistogramFigure& fig, const ScriptRanges& r) {
+  const double lo_decade = std::pow(10.0, std::floor(std::log10(r.ymin_pos / 3.0)));
+  const double hi_decade = std::max(std::pow(10.0, std::ceil(std::log10(std::max(r.ymax, r.curve_max) * 1.5))),
                                     100.0 * lo_decade);  // at least two labelled decades
   s << "LOGFLOOR = " << lo_decade / 10.0 << "\n"
     << "set logscale y 10\n"
@@ -317,8 +320,22 @@ std::string build_script(const HistogramFigure& fig, const fs::path& out) {
     << "set mytics 10\n"
     << "unset key\n"
     << "set grid ytics linestyle 100\n";
-  plot_cmd(true);
+  write_plot_command(s, fig, true);
+}
 
+std::string build_script(const HistogramFigure& fig, const fs::path& out) {
+  std::ostringstream s;
+  s.imbue(std::locale::classic());
+  s << std::setprecision(17);
+  ScriptRanges r;
+  write_histogram_block(s, fig, r);
+  write_curve_blocks(s, fig, r);
+  write_common_style(s, fig, out, r);
+  // The data set the ranges; a curve may raise them by at most a factor 2 (a divergent or badly
+  // wrong curve must not squash the measurement).
+  r.curve_max = std::min(r.curve_max, 2.0 * r.ymax);
+  write_linear_panel(s, fig, r);
+  write_log_panel(s, fig, r);
   s << "unset multiplot\n"
     << "unset output\n";
   return s.str();

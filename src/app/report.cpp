@@ -201,63 +201,86 @@ std::size_t GeometryReport::skipped() const {
       }));
 }
 
-GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
-  GeometryReport r;
-  r.scene = scene;
+namespace {
+
+// The design of a run, as analyse reads it: K spheres x M rotations (explicit) or n iid drops.
+struct DesignView {
+  bool expl = false;
+  std::size_t n = 0, K = 0, M = 0;
+  bool decisive = false;  ///< enough spheres to estimate the spread between them
+};
+
+DesignView design_view(const Scene& scene, const ContactSamples& s) {
+  DesignView v;
+  v.expl = s.mode == Mode::explicit_spheres;
+  v.n = s.r_xy.size();
+  v.K = v.expl ? scene.ensemble.spheres : v.n;
+  v.M = v.expl ? v.n / v.K : 1;
+  v.decisive = !v.expl || v.K >= kMinDecisiveSpheres;
+  return v;
+}
+
+// Counts, core-contact probabilities and the runner-up gap.
+void fill_counts(GeometryReport& r, const Scene& scene, const ContactSamples& s) {
   const auto& sp = scene.ensemble.sphere;
-  const bool expl = s.mode == Mode::explicit_spheres;
-  const std::size_t n = s.r_xy.size();
-  r.samples = n;
+  r.samples = s.r_xy.size();
   r.core_contacts = s.core_contacts;
   r.core_probability = core_contact_probability(sp.asperities, sp.radius, sp.asperity_radius);
   r.core_probability_paper = core_contact_probability_paper(sp.asperities, sp.radius, sp.asperity_radius);
   r.index_bytes = s.index_bytes;
   r.cross_check = s.cross_check;
-  {
-    std::vector<double> g = s.gap;
-    const auto q = quantiles_unsorted(g, std::vector<double>{0.0, 0.5});
-    r.gap_min = q[0];
-    r.gap_median = q[1];
-  }
-  const std::size_t K = expl ? scene.ensemble.spheres : n, M = expl ? n / K : 1;
-  const bool decisive_design = !expl || K >= kMinDecisiveSpheres;
-  // The design and its error budget.
-  {
-    auto& d = r.design;
-    d.kind = expl ? "explicit" : "sampled";
-    d.spheres = K;
-    d.rotations_per_sphere = M;
-    d.backend = expl ? std::string(to_string(scene.ensemble.backend)) : std::string("none");
-    const DesignScales sc = design_scales(s.mode, sp.asperities, K, n);
-    d.statistical_scale = sc.statistical;
-    d.quenched_scale = sc.quenched;
-    d.model_error_scale = model_error_scale(sp.asperities, sp.radius);
-  }
+  std::vector<double> g = s.gap;
+  const auto q = quantiles_unsorted(g, std::vector<double>{0.0, 0.5});
+  r.gap_min = q[0];
+  r.gap_median = q[1];
+}
+
+// The design and its error budget.
+GeometryReport::Design design_of(const Scene& scene, const ContactSamples& s, const DesignView& v) {
+  const auto& sp = scene.ensemble.sphere;
+  GeometryReport::Design d;
+  d.kind = v.expl ? "explicit" : "sampled";
+  d.spheres = v.K;
+  d.rotations_per_sphere = v.M;
+  d.backend = v.expl ? std::string(to_string(scene.ensemble.backend)) : std::string("none");
+  const DesignScales sc = design_scales(s.mode, sp.asperities, v.K, v.n);
+  d.statistical_scale = sc.statistical;
+  d.quenched_scale = sc.quenched;
+  d.model_error_scale = model_error_scale(sp.asperities, sp.radius);
+  return d;
+}
+
+// What the ensemble is and what its tests can decide, in words (report.json ensemble_note).
+std::string design_note(const GeometryReport& r, const Scene& scene, const DesignView& v) {
+  const auto& sp = scene.ensemble.sphere;
   std::ostringstream note;
-  if (expl) {
-    r.quenched_scale = quenched_deviation_scale(sp.asperities);
-    note << "explicit geometry: " << K << " sphere(s) of " << sp.asperities << " asperities x " << M
+  if (v.expl) {
+    note << "explicit geometry: " << v.K << " sphere(s) of " << sp.asperities << " asperities x " << v.M
          << " Haar-random rotations each; every contact found by a " << to_string(scene.ensemble.backend)
          << " spatial query. Rotations of one sphere sample that sphere's own (quenched) law, which differs from the "
             "ensemble law by a KS distance ~"
          << fmt(kQuenchedKs / std::sqrt(double(sp.asperities)), 3) << " per sphere; pooled over K spheres ~"
          << fmt(r.design.quenched_scale, 3) << ", against the statistical resolution ~" << fmt(r.design.statistical_scale, 3)
          << ". Standard errors come from the spread between spheres (batch means). ";
-    if (K == 1)
+    if (v.K == 1)
       note << "One sphere: the drops describe that sphere's own law; no test decides (verdict not-decisive).";
-    else if (!decisive_design)
+    else if (!v.decisive)
       note << "Fewer than " << kMinDecisiveSpheres
            << " spheres: too few to estimate the spread between spheres; no test decides (verdict not-decisive).";
     else
-      note << "Decisive tests: KS distance of all " << n
+      note << "Decisive tests: KS distance of all " << v.n
            << " drops on a grid of pooled-sample quantiles, p-value from a sphere-block bootstrap (resampling spheres).";
   } else {
     note << "sampled from the exact finite-N law of the lowest asperity -- no geometry: the two lowest asperities of "
             "each drop are drawn from the order statistics of the polar angle; no sphere is built. Drops are iid.";
   }
   if (!scene.legacy_mode.empty()) note << " " << legacy_mode_note(scene.legacy_mode);
-  r.ensemble_note = note.str();
+  return note.str();
+}
 
+// Summaries of every analysed quantity (batched by sphere when every drop has a value), and the
+// restitution deficit of impact runs.
+void summarise(GeometryReport& r, const Scene& scene, const ContactSamples& s, const DesignView& v) {
   std::vector<std::string> names;
   if (scene.contact_stats) names = {"r_xy", "r_x", "r_y", "r_z"};
   // Impact quantities are batched by sphere only when every drop impacted (no drop missing).
@@ -265,147 +288,194 @@ GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
   if (impact) names.insert(names.end(), {"eps", "omega_x_after"});
   for (const auto& q : names) {
     const auto& x = column(s, q);
-    const bool batched = expl && x.size() == n && M >= 2;
-    r.quantities.push_back({q, batched ? summarize_batches(x, K, kProbs) : summarize_iid(x, kProbs)});
+    const bool batched = v.expl && x.size() == v.n && v.M >= 2;
+    r.quantities.push_back({q, batched ? summarize_batches(x, v.K, kProbs) : summarize_iid(x, kProbs)});
   }
   if (impact) {
     std::vector<double> deficit(s.eps.size());
     for (std::size_t i = 0; i < deficit.size(); ++i) deficit[i] = s.eps_n[i] - s.eps[i];
-    const bool batched = expl && deficit.size() == n && M >= 2;
-    const Summary d = batched ? summarize_batches(deficit, K, kProbs) : summarize_iid(deficit, kProbs);
+    const bool batched = v.expl && deficit.size() == v.n && v.M >= 2;
+    const Summary d = batched ? summarize_batches(deficit, v.K, kProbs) : summarize_iid(deficit, kProbs);
     r.eps_deficit = d.mean;
     double en = 0;
     for (double e : s.eps_n) en += e;
     r.eps_n_mean = en / double(s.eps_n.size());
   }
   r.no_impacts = s.no_impacts;
+}
 
-  std::string law_note;
-  const bool impact_laws = s.no_impacts == 0 && s.eps.size() == n;
-  std::vector<SkippedLaw> skipped;
-  const auto law_sets = laws_for(scene.ensemble, scene.contact_stats, impact_laws, law_note, &skipped);
-  r.ensemble_note += law_note;
-  const std::string statistic = expl ? "KS-sphere-bootstrap" : "KS";
-  const auto skip = [&](const std::string& quantity, const std::string& law, bool decisive_law, std::size_t count,
-                        const std::string& reason) {
-    r.tests.push_back({quantity, law, "all", statistic, kNaN, kNaN, count, kNaN, !expl, decisive_law && decisive_design,
-                       "skipped", "not tested: " + reason});
-  };
-  const std::string printed_note = "as printed in the paper; reported for comparison, does not count toward the exit status";
-  for (std::size_t si = 0; si < law_sets.size(); ++si) {
-    const auto& set = law_sets[si];
-    const auto& x0 = column(s, set.quantity);
-    if (x0.empty()) continue;
-    const bool any_atom = std::any_of(set.has_atom.begin(), set.has_atom.end(), [](bool b) { return b; });
-    if (expl) {
-      // Core contacts sit exactly at the atom of the corrected laws (eps = eps_n, Omega'_x = Omega_x up to
-      // rounding): snap them so that the empirical cdf and the law's cdf step at the same point.
-      std::vector<double> x(x0.begin(), x0.end());
-      if (any_atom && s.eps_core.size() == x.size())
-        for (std::size_t i = 0; i < x.size(); ++i)
-          if (s.eps_core[i]) x[i] = set.atom;
-      const std::vector<double> extra = any_atom ? std::vector<double>{set.atom} : std::vector<double>{};
-      std::vector<Cdf> cdfs;
-      std::vector<std::size_t> which;
-      for (std::size_t li = 0; li < set.laws.size(); ++li) {
-        // Every cdf is evaluated at ~10^3 grid points only; a law that cannot be evaluated is skipped.
-        try {
-          (void)set.laws[li].cdf(x[0]);
-          cdfs.push_back(set.laws[li].cdf);
-          which.push_back(li);
-        } catch (const std::exception& ex) {
-          r.ensemble_note += " Law " + set.laws[li].name + " not tested: it cannot be evaluated at these parameters (" +
-                             ex.what() + ").";
-          skip(set.quantity, set.laws[li].name, set.decisive[li], x.size(),
-               std::string("cannot be evaluated at these parameters: ") + ex.what());
-        }
-      }
-      if (cdfs.empty()) continue;
-      const BlockBins bins = bin_by_block(x, x.size() == n ? K : 1, kKsGrid, kMaxBlocks, extra);
-      std::vector<BlockKsResult> res;
-      std::vector<double> dist;
-      try {
-        if (decisive_design && x.size() == n) {
-          res = block_ks_tests(bins, cdfs, scene.alpha, scene.ensemble.seed, si);
-        } else {
-          for (const auto& f : cdfs) res.push_back({binned_ks_distance(bins, f), kNaN, 0, "not-decisive"});
-        }
-      } catch (const std::exception& ex) {
-        for (std::size_t j = 0; j < which.size(); ++j)
-          skip(set.quantity, set.laws[which[j]].name, set.decisive[which[j]], x.size(),
-               std::string("cannot be evaluated at these parameters: ") + ex.what());
-        continue;
-      }
-      for (std::size_t j = 0; j < which.size(); ++j) {
-        const Law& law = set.laws[which[j]];
-        const bool decisive_law = set.decisive[which[j]];
-        TestReport t{set.quantity, law.name, "all", statistic, res[j].D, res[j].p, x.size(), law.mean, false,
-                     decisive_law && decisive_design && res[j].verdict != "not-decisive", res[j].verdict, ""};
-        if (res[j].verdict == "not-decisive") {
-          t.p = kolmogorov_pvalue(res[j].D, x.size());
-          t.note = K == 1 ? "one sphere: that sphere's own law against the ensemble law; the p-value assumes iid drops "
-                            "(they are not): decides nothing"
-                          : "fewer than " + std::to_string(kMinDecisiveSpheres) +
-                                " spheres: the p-value assumes iid drops (they are not): decides nothing";
-        } else {
-          t.note = "B = " + std::to_string(res[j].replicates) + " sphere-block bootstrap replicates over " +
-                   std::to_string(bins.blocks) + " blocks";
-          if (res[j].verdict == "undecided") t.note += "; cannot decide at this B (smallest attainable p is not below alpha)";
-          if (!decisive_law) t.note = printed_note + "; " + t.note;
-        }
-        if (set.has_atom.size() > which[j] && set.has_atom[which[j]])
-          t.note += "; includes core contacts as an atom of mass " + fmt(set.atom_mass, 3);
-        r.tests.push_back(t);
-      }
+const std::string kPrintedNote = "as printed in the paper; reported for comparison, does not count toward the exit status";
+
+// What the law tests of one run share.
+struct TestContext {
+  const Scene& scene;
+  const ContactSamples& s;
+  DesignView v;
+  std::string statistic;  ///< of the law tests: "KS-sphere-bootstrap" (explicit) or "KS"
+};
+
+// A law the run could not test: verdict "skipped", D, p and predicted_mean NaN.
+TestReport skipped_test(const TestContext& c, const std::string& quantity, const std::string& law, bool decisive_law,
+                        std::size_t count, const std::string& reason) {
+  return {quantity, law, "all", c.statistic, kNaN, kNaN, count, kNaN, !c.v.expl, decisive_law && c.v.decisive,
+          "skipped", "not tested: " + reason};
+}
+
+// The laws of `set` that can be evaluated (at x[0]), as (index, cdf); the others are skipped, with
+// a note in the report.
+std::vector<std::pair<std::size_t, Cdf>> evaluable_laws(GeometryReport& r, const TestContext& c, const LawSet& set,
+                                                        const std::vector<double>& x) {
+  std::vector<std::pair<std::size_t, Cdf>> out;
+  for (std::size_t li = 0; li < set.laws.size(); ++li) {
+    // Every cdf is evaluated at ~10^3 grid points only; a law that cannot be evaluated is skipped.
+    try {
+      (void)set.laws[li].cdf(x[0]);
+      out.emplace_back(li, set.laws[li].cdf);
+    } catch (const std::exception& ex) {
+      r.ensemble_note += " Law " + set.laws[li].name + " not tested: it cannot be evaluated at these parameters (" +
+                         ex.what() + ").";
+      r.tests.push_back(skipped_test(c, set.quantity, set.laws[li].name, set.decisive[li], x.size(),
+                                     std::string("cannot be evaluated at these parameters: ") + ex.what()));
+    }
+  }
+  return out;
+}
+
+// The row of one law of the explicit design, from its block-bootstrap (or not-decisive) result.
+TestReport explicit_test(const TestContext& c, const LawSet& set, std::size_t li, const BlockKsResult& res,
+                         const BlockBins& bins, std::size_t count) {
+  const Law& law = set.laws[li];
+  const bool decisive_law = set.decisive[li];
+  TestReport t{set.quantity, law.name, "all", c.statistic, res.D, res.p, count, law.mean, false,
+               decisive_law && c.v.decisive && res.verdict != "not-decisive", res.verdict, ""};
+  if (res.verdict == "not-decisive") {
+    t.p = kolmogorov_pvalue(res.D, count);
+    t.note = c.v.K == 1 ? "one sphere: that sphere's own law against the ensemble law; the p-value assumes iid drops "
+                          "(they are not): decides nothing"
+                        : "fewer than " + std::to_string(kMinDecisiveSpheres) +
+                              " spheres: the p-value assumes iid drops (they are not): decides nothing";
+  } else {
+    t.note = "B = " + std::to_string(res.replicates) + " sphere-block bootstrap replicates over " +
+             std::to_string(bins.blocks) + " blocks";
+    if (res.verdict == "undecided") t.note += "; cannot decide at this B (smallest attainable p is not below alpha)";
+    if (!decisive_law) t.note = kPrintedNote + "; " + t.note;
+  }
+  if (set.has_atom.size() > li && set.has_atom[li])
+    t.note += "; includes core contacts as an atom of mass " + fmt(set.atom_mass, 3);
+  return t;
+}
+
+// Explicit design: the binned KS distance of all drops against each law; p from the sphere-block
+// bootstrap when the design can decide. `stream` (the set's index) keeps the replicates apart.
+void test_explicit(GeometryReport& r, const TestContext& c, const LawSet& set, std::size_t stream) {
+  const auto& x0 = column(c.s, set.quantity);
+  const bool any_atom = std::any_of(set.has_atom.begin(), set.has_atom.end(), [](bool b) { return b; });
+  // Core contacts sit exactly at the atom of the corrected laws (eps = eps_n, Omega'_x = Omega_x up to
+  // rounding): snap them so that the empirical cdf and the law's cdf step at the same point.
+  std::vector<double> x(x0.begin(), x0.end());
+  if (any_atom && c.s.eps_core.size() == x.size())
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (c.s.eps_core[i]) x[i] = set.atom;
+  const std::vector<double> extra = any_atom ? std::vector<double>{set.atom} : std::vector<double>{};
+  const auto laws = evaluable_laws(r, c, set, x);
+  if (laws.empty()) return;
+  std::vector<Cdf> cdfs;
+  for (const auto& [li, cdf] : laws) cdfs.push_back(cdf);
+  const BlockBins bins = bin_by_block(x, x.size() == c.v.n ? c.v.K : 1, kKsGrid, kMaxBlocks, extra);
+  std::vector<BlockKsResult> res;
+  try {
+    if (c.v.decisive && x.size() == c.v.n) {
+      res = block_ks_tests(bins, cdfs, c.scene.alpha, c.scene.ensemble.seed, stream);
+    } else {
+      for (const auto& f : cdfs) res.push_back({binned_ks_distance(bins, f), kNaN, 0, "not-decisive"});
+    }
+  } catch (const std::exception& ex) {
+    for (const auto& [li, cdf] : laws)
+      r.tests.push_back(skipped_test(c, set.quantity, set.laws[li].name, set.decisive[li], x.size(),
+                                     std::string("cannot be evaluated at these parameters: ") + ex.what()));
+    return;
+  }
+  for (std::size_t j = 0; j < laws.size(); ++j) r.tests.push_back(explicit_test(c, set, laws[j].first, res[j], bins, x.size()));
+}
+
+// Sampled design: iid drops, the exact one-sample KS test (randomised PIT at a law's atom).
+void test_sampled(GeometryReport& r, const TestContext& c, const LawSet& set) {
+  const auto& x0 = column(c.s, set.quantity);
+  const auto all = sorted(x0);
+  for (std::size_t li = 0; li < set.laws.size(); ++li) {
+    const Law& law = set.laws[li];
+    const bool decisive_law = set.decisive[li];
+    TestReport t{set.quantity, law.name, "all", "KS", 0, 1, x0.size(), law.mean, true, decisive_law, "", ""};
+    if (!decisive_law) t.note = kPrintedNote;
+    const bool atom = li < set.has_atom.size() && set.has_atom[li];
+    KsResult ks;
+    try {
+      ks = atom ? ks_mixed(x0, c.s.eps_core, law, set.atom, set.atom_mass, c.scene.ensemble.seed)
+                : ks_one_sample(all, law.cdf);
+    } catch (const std::exception& ex) {
+      r.ensemble_note += " Law " + law.name + " not tested: it cannot be evaluated at these parameters (" +
+                         ex.what() + ").";
+      r.tests.push_back(skipped_test(c, set.quantity, law.name, decisive_law, x0.size(),
+                                     std::string("cannot be evaluated at these parameters: ") + ex.what()));
       continue;
     }
-    // Sampled: iid drops, the exact one-sample KS test.
-    const auto all = sorted(x0);
-    for (std::size_t li = 0; li < set.laws.size(); ++li) {
-      const Law& law = set.laws[li];
-      const bool decisive_law = set.decisive[li];
-      TestReport t{set.quantity, law.name, "all", "KS", 0, 1, x0.size(), law.mean, true, decisive_law, "", ""};
-      if (!decisive_law) t.note = printed_note;
-      const bool atom = li < set.has_atom.size() && set.has_atom[li];
-      KsResult ks;
-      try {
-        ks = atom ? ks_mixed(x0, s.eps_core, law, set.atom, set.atom_mass, scene.ensemble.seed)
-                  : ks_one_sample(all, law.cdf);
-      } catch (const std::exception& ex) {
-        r.ensemble_note += " Law " + law.name + " not tested: it cannot be evaluated at these parameters (" +
-                           ex.what() + ").";
-        skip(set.quantity, law.name, decisive_law, x0.size(),
-             std::string("cannot be evaluated at these parameters: ") + ex.what());
-        continue;
-      }
-      if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
-      t.D = ks.D, t.p = ks.p;
-      t.verdict = ks.p < scene.alpha ? "reject" : "accept";
-      r.tests.push_back(t);
-    }
-  }
-
-  for (const auto& l : skipped) skip(l.quantity, l.law, l.decisive, column(s, l.quantity).size(), l.reason);
-
-  if (scene.contact_stats) {
-    // Core contacts: binomial(drops, P_core) for iid drops; two-sided exact p-value. In the explicit
-    // design the count of one sphere is overdispersed (its own core probability): information only.
-    TestReport t{"core_contacts", "exact-sphere", "all", "binomial", kNaN, 1, n,
-                 r.core_probability * double(n), !expl, !expl, "", ""};
-    boost::math::binomial_distribution<double> b(double(n), r.core_probability);
-    const double k = double(s.core_contacts);
-    const double lower = boost::math::cdf(b, k);
-    const double upper = k > 0 ? boost::math::cdf(boost::math::complement(b, k - 1)) : 1.0;
-    t.p = std::min(1.0, 2.0 * std::min(lower, upper));
-    t.verdict = t.p < scene.alpha ? "reject" : "accept";
-    t.note = "central sphere touched first; the paper's estimate exp(-N a/R) = " + fmt(r.core_probability_paper, 3) +
-             " per drop, exact (1 - a/2R)^N = " + fmt(r.core_probability, 3);
-    if (expl) t.note += "; iid binomial p-value, the spread between spheres is not accounted for: information only";
+    if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
+    t.D = ks.D, t.p = ks.p;
+    t.verdict = ks.p < c.scene.alpha ? "reject" : "accept";
     r.tests.push_back(t);
   }
+}
+
+// Every law of the requested outputs against its sample; laws that could not be tested are listed.
+void test_laws(GeometryReport& r, const TestContext& c) {
+  std::string law_note;
+  const bool impact_laws = c.s.no_impacts == 0 && c.s.eps.size() == c.v.n;
+  std::vector<SkippedLaw> skipped;
+  const auto law_sets = laws_for(c.scene.ensemble, c.scene.contact_stats, impact_laws, law_note, &skipped);
+  r.ensemble_note += law_note;
+  for (std::size_t si = 0; si < law_sets.size(); ++si) {
+    if (column(c.s, law_sets[si].quantity).empty()) continue;
+    if (c.v.expl) test_explicit(r, c, law_sets[si], si);
+    else test_sampled(r, c, law_sets[si]);
+  }
+  for (const auto& l : skipped)
+    r.tests.push_back(skipped_test(c, l.quantity, l.law, l.decisive, column(c.s, l.quantity).size(), l.reason));
+}
+
+// Core contacts: binomial(drops, P_core) for iid drops; two-sided exact p-value. In the explicit
+// design the count of one sphere is overdispersed (its own core probability): information only.
+TestReport core_contact_test(const GeometryReport& r, const Scene& scene, const ContactSamples& s, const DesignView& v) {
+  const std::size_t n = v.n;
+  TestReport t{"core_contacts", "exact-sphere", "all", "binomial", kNaN, 1, n,
+               r.core_probability * double(n), !v.expl, !v.expl, "", ""};
+  boost::math::binomial_distribution<double> b(double(n), r.core_probability);
+  const double k = double(s.core_contacts);
+  const double lower = boost::math::cdf(b, k);
+  const double upper = k > 0 ? boost::math::cdf(boost::math::complement(b, k - 1)) : 1.0;
+  t.p = std::min(1.0, 2.0 * std::min(lower, upper));
+  t.verdict = t.p < scene.alpha ? "reject" : "accept";
+  t.note = "central sphere touched first; the paper's estimate exp(-N a/R) = " + fmt(r.core_probability_paper, 3) +
+           " per drop, exact (1 - a/2R)^N = " + fmt(r.core_probability, 3);
+  if (v.expl) t.note += "; iid binomial p-value, the spread between spheres is not accounted for: information only";
+  return t;
+}
+
+}  // namespace
+
+GeometryReport analyse(const Scene& scene, const ContactSamples& s) {
+  GeometryReport r;
+  r.scene = scene;
+  const DesignView v = design_view(scene, s);
+  fill_counts(r, scene, s);
+  r.design = design_of(scene, s, v);
+  if (v.expl) r.quenched_scale = quenched_deviation_scale(scene.ensemble.sphere.asperities);
+  r.ensemble_note = design_note(r, scene, v);
+  summarise(r, scene, s, v);
+  test_laws(r, TestContext{scene, s, v, v.expl ? "KS-sphere-bootstrap" : "KS"});
+  if (scene.contact_stats) r.tests.push_back(core_contact_test(r, scene, s, v));
   r.timings_s = {{"generate", s.seconds_generate}, {"index", s.seconds_index}, {"query", s.seconds_query}};
   if (scene.ensemble.impact.enabled) r.timings_s.emplace_back("impact", s.seconds_impact);
-  if (expl) r.timings_s.emplace_back("cross_check", s.cross_check.seconds);
+  if (v.expl) r.timings_s.emplace_back("cross_check", s.cross_check.seconds);
   return r;
 }
 
@@ -583,6 +653,7 @@ std::string with_header(const std::string& body, const ReportHeader& h) {
   if (!h.scene_toml.empty()) j["scene_file"] = h.scene_toml;
   if (!h.plan.empty()) j["plan"] = plan_json(h.plan);
   if (!h.timings_s.empty()) j["timings_s"] = timings_json(h.timings_s);
+  for (const auto& [name, text] : h.sections) j[name] = json::parse(text);
   return j.dump(2) + "\n";
 }
 

@@ -95,6 +95,12 @@ MemoryEstimate estimate_memory(const Scene& s) {
         d << " + " << fmt(concurrent) << " sphere(s) at once (--threads " << threads_of(s) << ") x " << count(e.sphere.asperities)
           << " asperities x " << b << " B (" << to_string(pe.backend) << ")";
       }
+      if (s.cor_table) {  // after the run, its samples freed: one speed's drops at a time
+        // + the eps-rank order of the omega bands (8 B per drop)
+        const double table = kBaseSphere + (kPerDropImpact + 8.0) * double(s.cor_table->drops);
+        if (table > m.bytes) d << "; outputs.cor_table: " << count(s.cor_table->drops) << " drops per speed x " << kPerDropImpact << " B";
+        m.bytes = std::max(m.bytes, table);
+      }
       break;
     }
     case RunKind::radii: {

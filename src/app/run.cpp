@@ -13,10 +13,12 @@
 #include <sstream>
 
 #include <Eigen/Eigenvalues>
+#include <nlohmann/json.hpp>
 
 #include "asperity/experiments/body_bounce.hpp"
 #include "asperity/experiments/body_experiments.hpp"
 #include "asperity/experiments/bounce.hpp"
+#include "asperity/app/cor_table.hpp"
 #include "asperity/app/experiment_reports.hpp"
 #include "asperity/app/mesh_io.hpp"
 #include "asperity/app/output_staging.hpp"
@@ -253,6 +255,29 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress, const std:
   return o;
 }
 
+// outputs.cor_table: the restitution table and its JSON header beside the report, named in the
+// report (with the ensemble that produced it) and in the table's last lines.
+void write_scene_cor_table(const Scene& s, const Progress& progress, const std::filesystem::path& dir, SceneOutput& o,
+                           ReportHeader& h) {
+  const auto t0 = Clock::now();
+  const CorTableSpec spec = cor_table_spec(s, *s.cor_table);
+  const CorTable t = make_cor_table(spec, progress);
+  write_cor_table(dir / s.cor_table->file, t);
+  const std::string header = cor_table_header_name(s.cor_table->file);
+  o.files.push_back(s.cor_table->file);
+  o.files.push_back(header);
+  const double seconds = since(t0);
+  h.timings_s.emplace_back("cor_table", seconds);
+  const nlohmann::json j = {{"file", s.cor_table->file}, {"header", header},     {"ensemble", kCorTableEnsemble},
+                            {"speeds", spec.speeds},    {"probabilities", spec.probabilities}, {"drops_per_speed", spec.drops},
+                            {"format", t.format()},      {"spins", spec.spins},  {"omega_bands", spec.omega_bands}};
+  h.sections.emplace_back("cor_table", j.dump());
+  std::ostringstream line;
+  line << "\nrestitution table: " << s.cor_table->file << " (+ " << header << "), " << spec.speeds.size() << " speeds x "
+       << spec.drops << " drops, " << spec.probabilities << " probabilities; " << kCorTableEnsemble << "\n";
+  o.table += line.str();
+}
+
 SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
   const GeometryReport r = run_scene(s, progress, dir);
   SceneOutput o;
@@ -267,6 +292,7 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
   h.scene_toml = r.scene_toml;
   h.plan = r.plan;
   h.timings_s = r.timings_s;
+  if (s.cor_table) write_scene_cor_table(s, progress, dir.empty() ? s.out : dir, o, h);
   o.json = with_header(to_json(r), h);
   return o;
 }

@@ -66,6 +66,33 @@ std::string report_table_name(const std::string& report) {
   return txt.string();
 }
 
+std::string cor_table_header_name(const std::string& csv) {
+  return std::filesystem::path(csv).replace_extension(".json").string();
+}
+
+namespace {
+
+// The table's own limits are checked where it is built (validate(CorTableSpec)); here: what the
+// scene decides -- which runs may write one, and names that collide with no other output.
+void validate_cor_table(const Scene& s) {
+  const CorTableScene& c = *s.cor_table;
+  const std::string key = "outputs.cor_table";
+  if (s.mesh || s.radii || s.bounce.enabled || !s.ensemble.impact.enabled)
+    throw std::invalid_argument(key + ": only for a sphere impact scene (body.kind = \"sphere\", experiment.kind = "
+                                "\"impact\", one asperity radius)");
+  if (const std::string why = output_name_problem(c.file); !why.empty())
+    throw std::invalid_argument(key + ".file: \"" + printable(c.file) + "\" " + why);
+  if (std::filesystem::path(c.file).extension() != ".csv")
+    throw std::invalid_argument(key + ".file: \"" + c.file + "\" must end in .csv (its header is written as .json)");
+  const std::string header = cor_table_header_name(c.file);
+  for (const std::string& taken : {s.report, report_table_name(s.report)})
+    if (c.file == taken || header == taken)
+      throw std::invalid_argument(key + ".file: \"" + c.file + "\" and its header \"" + header +
+                                  "\" must differ from the report and its table (\"" + taken + "\")");
+}
+
+}  // namespace
+
 void validate(const Scene& s) {
   if (s.mesh) {
     // A mesh body's size is its mesh x scale (check_scene_inputs, run.hpp, checks the asperity
@@ -96,6 +123,7 @@ void validate(const Scene& s) {
     if (ends_with_png(ply))
       throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" would collide with the figures (*.png)");
   }
+  if (s.cor_table) validate_cor_table(s);
   if (s.name.empty()) throw std::invalid_argument("name must not be empty");
   if (s.bounce.enabled) {
     validate(s.bounce);

@@ -246,6 +246,40 @@ class Reader {
 
 constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
 
+// [outputs.cor_table]: file (required), speeds, probabilities, drops, spins, omega_bands. The names are checked against
+// the run's other outputs by validate(Scene); the table's own ranges here, each key named.
+CorTableScene read_cor_table(Reader& t) {
+  CorTableScene c;
+  const auto file = t.text("file");
+  if (!file) t.missing("file", "the table's CSV file name inside outputs.dir, e.g. \"cor.csv\"");
+  c.file = *file;
+  if (auto v = t.reals("speeds")) {
+    for (std::size_t i = 0; i < v->size(); ++i) {
+      const double u = (*v)[i];
+      if (!(u > 0) || u > 1e8) t.bad("speeds", "each speed must be > 0 and <= 1e8 m/s, got " + num(u));
+      if (i > 0 && !(u > (*v)[i - 1])) t.bad("speeds", "must ascend strictly, got " + num((*v)[i - 1]) + " then " + num(u));
+    }
+    if (v->size() > 1000) t.bad("speeds", "at most 1000 speeds, got " + std::to_string(v->size()));
+    c.speeds = *v;
+  }
+  if (auto p = t.count("probabilities", 2, 100001)) c.probabilities = *p;
+  if (auto d = t.count("drops", 3, kMaxDrops)) c.drops = *d;
+  if (auto w = t.reals("spins")) {
+    for (std::size_t i = 0; i < w->size(); ++i) {
+      if (std::abs((*w)[i]) > 1e6) t.bad("spins", "each |spin| must be <= 1e6 rad/s, got " + num((*w)[i]));
+      if (i > 0 && !((*w)[i] > (*w)[i - 1])) t.bad("spins", "must ascend strictly, got " + num((*w)[i - 1]) + " then " + num((*w)[i]));
+    }
+    if (w->size() > 1000) t.bad("spins", "at most 1000 spins, got " + std::to_string(w->size()));
+    c.spins = *w;
+  }
+  if (auto b = t.count("omega_bands", 0, 1000)) {
+    if (2 * *b > c.drops) t.bad("omega_bands", "at most drops / 2 = " + std::to_string(c.drops / 2) + ", got " + std::to_string(*b));
+    c.omega_bands = *b;
+  }
+  t.finish();
+  return c;
+}
+
 // THE mapping from a scene file to a Scene: every section and key of format 1 is read here, and
 // nowhere else. New engine features (mesh bodies, radius distributions, bounce experiments, ...)
 // are wired in by replacing the matching `unsupported(...)` with a field of Scene.
@@ -284,217 +318,277 @@ TangentialLaw read_tangential(Reader& t) {
   return law;
 }
 
-Scene scene_from_toml(const toml::table& root, std::string_view origin) {
-  Reader top(root, "", origin);
-  Scene s;
+// Reads `format` (which must be the library's) and `name`.
+void read_header(Reader& top, Scene& s) {
   const auto format = top.count("format", 1, std::numeric_limits<std::int64_t>::max());
   if (!format) top.missing("format", "write format = " + std::to_string(kSceneFormatVersion) + " as the first line");
   if (*format != kSceneFormatVersion)
     top.bad("format", "this library reads format " + std::to_string(kSceneFormatVersion) + ", got " +
                           std::to_string(*format));
   s.name = top.text("name").value_or("custom");
+}
 
-  // [body]
-  double R = s.ensemble.sphere.radius;
-  if (auto body = top.table("body")) {
-    const auto kind = body->choice("kind", {"sphere", "mesh"}).value_or("sphere");
-    if (kind == "mesh") {
-      MeshBodyScene m;
-      const auto file = body->text("mesh");
-      if (!file) body->missing("mesh", "a mesh file (OFF/PLY/STL/OBJ), e.g. mesh = \"../meshes/ellipsoid.off\"");
-      m.file = *file;
-      if (auto sc = body->positive("scale", "(mesh units -> m)")) m.scale = *sc;
-      if (auto sm = body->reals("smooth")) {
-        if (sm->size() != 3 && sm->size() != 4)
-          body->bad("smooth", "expected [a, b, c] or [a, b, c, m] [m], got " + std::to_string(sm->size()) + " numbers");
-        for (std::size_t i = 0; i < sm->size(); ++i)
-          if (!((*sm)[i] > 0)) body->bad("smooth", "element " + std::to_string(i) + " must be > 0, got " + num((*sm)[i]));
-        // The supported lengths (geometry.hpp); check_scene_inputs (run.hpp) also matches them to the mesh.
-        for (std::size_t i = 0; i < 3; ++i)
-          if (!((*sm)[i] >= kMinLength && (*sm)[i] <= kMaxLength))
-            body->bad("smooth", "semi-axis " + std::to_string(i) + " must be in [" + num(kMinLength) + ", " +
-                                    num(kMaxLength) + "] m (supported range), got " + num((*sm)[i]));
-        if (sm->size() == 4 && !((*sm)[3] >= 2 && (*sm)[3] <= kMaxSuperellipsoidExponent))
-          body->bad("smooth", "exponent m must be in [2, " + std::to_string(static_cast<int>(kMaxSuperellipsoidExponent)) + "], got " + num((*sm)[3]));
-        m.smooth = *sm;
-      }
-      if (body->has("radius")) body->bad("radius", "only for kind = \"sphere\" (a mesh body's size is the mesh x scale)");
-      s.mesh = std::move(m);
-    } else {
-      for (const char* k : {"mesh", "scale", "smooth"})
-        if (body->has(k)) body->bad(k, "only for kind = \"mesh\"");
-    }
-    if (auto r = body->positive("radius", "m")) R = *r;
-    body->finish();
+// body.smooth = [a, b, c] or [a, b, c, m]: the (super)ellipsoid the asperity centres are mapped onto.
+std::vector<double> read_smooth(Reader& body, std::vector<double> sm) {
+  if (sm.size() != 3 && sm.size() != 4)
+    body.bad("smooth", "expected [a, b, c] or [a, b, c, m] [m], got " + std::to_string(sm.size()) + " numbers");
+  for (std::size_t i = 0; i < sm.size(); ++i)
+    if (!(sm[i] > 0)) body.bad("smooth", "element " + std::to_string(i) + " must be > 0, got " + num(sm[i]));
+  // The supported lengths (geometry.hpp); check_scene_inputs (run.hpp) also matches them to the mesh.
+  for (std::size_t i = 0; i < 3; ++i)
+    if (!(sm[i] >= kMinLength && sm[i] <= kMaxLength))
+      body.bad("smooth", "semi-axis " + std::to_string(i) + " must be in [" + num(kMinLength) + ", " +
+                             num(kMaxLength) + "] m (supported range), got " + num(sm[i]));
+  if (sm.size() == 4 && !(sm[3] >= 2 && sm[3] <= kMaxSuperellipsoidExponent))
+    body.bad("smooth", "exponent m must be in [2, " + std::to_string(static_cast<int>(kMaxSuperellipsoidExponent)) +
+                           "], got " + num(sm[3]));
+  return sm;
+}
+
+MeshBodyScene read_mesh_body(Reader& body) {
+  MeshBodyScene m;
+  const auto file = body.text("mesh");
+  if (!file) body.missing("mesh", "a mesh file (OFF/PLY/STL/OBJ), e.g. mesh = \"../meshes/ellipsoid.off\"");
+  m.file = *file;
+  if (auto sc = body.positive("scale", "(mesh units -> m)")) m.scale = *sc;
+  if (auto sm = body.reals("smooth")) m.smooth = read_smooth(body, std::move(*sm));
+  if (body.has("radius")) body.bad("radius", "only for kind = \"sphere\" (a mesh body's size is the mesh x scale)");
+  return m;
+}
+
+// [body]: the paper's sphere (radius) or a mesh body.
+void read_body(Reader& top, Scene& s) {
+  auto body = top.table("body");
+  if (!body) return;
+  const auto kind = body->choice("kind", {"sphere", "mesh"}).value_or("sphere");
+  if (kind == "mesh") {
+    s.mesh = read_mesh_body(*body);
+  } else {
+    for (const char* k : {"mesh", "scale", "smooth"})
+      if (body->has(k)) body->bad(k, "only for kind = \"mesh\"");
   }
-  s.ensemble.sphere.radius = R;
+  if (auto r = body->positive("radius", "m")) s.ensemble.sphere.radius = *r;
+  body->finish();
+}
 
-  // [material]
+// material.restitution: the viscoelastic model of Eq. 9 (a constant one is refused, not ignored).
+void read_restitution(Reader& rest, ImpactExperiment& impact) {
+  const auto model = rest.choice("model", {"viscoelastic", "constant"});
+  if (!model) rest.missing("model", "\"viscoelastic\" (with beta) or \"constant\" (with value)");
+  if (*model == "viscoelastic") {
+    const auto beta = rest.positive("beta", "(s/m)^(1/5)");
+    if (!beta) rest.missing("beta", "Pade [1/4] constant of Eq. 9, e.g. 0.0467 for steel");
+    impact.beta = *beta;
+  } else {
+    if (auto v = rest.real("value"); v && (*v < 0 || *v > 1))
+      rest.bad("value", "must be in [0, 1], got " + num(*v));
+    rest.unsupported("model", "impacts use the viscoelastic model only");
+  }
+  rest.finish();
+}
+
+// [material]: density, the tangential law (eps_t or material.tangential, once) and restitution.
+void read_material(Reader& top, Scene& s) {
+  auto mat = top.table("material");
+  if (!mat) return;
   auto& impact = s.ensemble.impact;
-  if (auto mat = top.table("material")) {
-    if (auto d = mat->positive("density", "kg/m^3")) impact.density = *d;
-    const bool eps_t_given = mat->has("eps_t");
-    if (auto e = mat->real("eps_t")) {
-      if (*e < -1 || *e > 1) mat->bad("eps_t", "must be in [-1, 1], got " + num(*e));
-      impact.eps_t = *e;
-    }
-    if (auto tan = mat->table("tangential")) {
-      impact.tangential = read_tangential(*tan);
-      if (impact.tangential.model != TangentialLaw::Model::kinematic) {
-        if (eps_t_given) mat->bad("eps_t", "belongs to the kinematic law; material.tangential chose " + impact.tangential.describe());
-        if (!s.mesh)
-          tan->bad("model", "laws other than \"kinematic\" apply to mesh bodies (body.kind = \"mesh\") in this release, got \"" +
-                            std::string(to_string(impact.tangential.model)) + "\"");
-      } else if (eps_t_given) {
-        mat->bad("eps_t", "give it once: tangential = { model = \"kinematic\", eps_t = ... } or eps_t, not both");
-      } else {
-        impact.eps_t = impact.tangential.eps_t;
-      }
-    }
-    if (auto rest = mat->table("restitution")) {
-      const auto model = rest->choice("model", {"viscoelastic", "constant"});
-      if (!model) rest->missing("model", "\"viscoelastic\" (with beta) or \"constant\" (with value)");
-      if (*model == "viscoelastic") {
-        const auto beta = rest->positive("beta", "(s/m)^(1/5)");
-        if (!beta) rest->missing("beta", "Pade [1/4] constant of Eq. 9, e.g. 0.0467 for steel");
-        impact.beta = *beta;
-      } else {
-        if (auto v = rest->real("value"); v && (*v < 0 || *v > 1))
-          rest->bad("value", "must be in [0, 1], got " + num(*v));
-        rest->unsupported("model", "impacts use the viscoelastic model only");
-      }
-      rest->finish();
-    }
-    mat->finish();
+  if (auto d = mat->positive("density", "kg/m^3")) impact.density = *d;
+  const bool eps_t_given = mat->has("eps_t");
+  if (auto e = mat->real("eps_t")) {
+    if (*e < -1 || *e > 1) mat->bad("eps_t", "must be in [-1, 1], got " + num(*e));
+    impact.eps_t = *e;
   }
+  if (auto tan = mat->table("tangential")) {
+    impact.tangential = read_tangential(*tan);
+    if (impact.tangential.model != TangentialLaw::Model::kinematic) {
+      if (eps_t_given) mat->bad("eps_t", "belongs to the kinematic law; material.tangential chose " + impact.tangential.describe());
+      if (!s.mesh)
+        tan->bad("model", "laws other than \"kinematic\" apply to mesh bodies (body.kind = \"mesh\") in this release, got \"" +
+                          std::string(to_string(impact.tangential.model)) + "\"");
+    } else if (eps_t_given) {
+      mat->bad("eps_t", "give it once: tangential = { model = \"kinematic\", eps_t = ... } or eps_t, not both");
+    } else {
+      impact.eps_t = impact.tangential.eps_t;
+    }
+  }
+  if (auto rest = mat->table("restitution")) read_restitution(*rest, impact);
+  mat->finish();
+}
 
-  // [asperities]
+// asperities.count or asperities.areal_density (on the sphere of radius R), one of them.
+void read_asperity_count(Reader& asp, Scene& s, double R) {
+  const auto n = asp.count("count", 1, kMaxAsperities);
+  const auto eta = asp.positive("areal_density", "per m^2");
+  if (n && eta) asp.bad("areal_density", "give either count or areal_density, not both");
+  if (eta && s.mesh) asp.bad("areal_density", "a mesh body needs count (N per body), got areal_density = " + num(*eta));
+  if (n) s.ensemble.sphere.asperities = *n;
+  if (eta) {
+    const double count = std::round(*eta * 4.0 * std::numbers::pi * R * R);
+    if (!(count >= 1) || count > double(kMaxAsperities))
+      asp.bad("areal_density", num(*eta) + " per m^2 on a sphere of radius " + num(R) + " m gives " + num(count) +
+                                   " asperities; need 1 .. 2^32-1");
+    s.ensemble.sphere.asperities = static_cast<std::uint64_t>(count);
+  }
+}
+
+// Message for a length outside the supported range (geometry.hpp), "" when it is inside.
+std::string length_range_problem(double a) {
+  if (a >= kMinLength && a <= kMaxLength) return "";
+  return "must be in [" + num(kMinLength) + ", " + num(kMaxLength) + "] m (supported range), got " + num(a);
+}
+
+// distribution = "fixed": every asperity has radius `value` (the paper).
+void read_fixed_radius(Reader& rad, Scene& s, double R) {
+  const auto a = rad.positive("value", "m");
+  if (!a) rad.missing("value", "the asperity radius a [m]");
+  if (const std::string why = length_range_problem(*a); !why.empty()) rad.bad("value", why);
+  if (!s.mesh && *a >= R) rad.bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
+  s.ensemble.sphere.asperity_radius = *a;
+}
+
+RadiusDistribution read_lognormal_radius(Reader& rad, const Scene& s, double R) {
+  const auto median = rad.positive("median", "m");
+  if (!median) rad.missing("median", "the median asperity radius exp(mu) [m]");
+  if (const std::string why = length_range_problem(*median); !why.empty()) rad.bad("median", why);
+  const auto sigma = rad.real("sigma");
+  if (!sigma) rad.missing("sigma", "the standard deviation of ln(radius), e.g. 0.3");
+  if (*sigma < 0) rad.bad("sigma", "must be >= 0, got " + num(*sigma));
+  if (!s.mesh && *median >= R) rad.bad("median", num(*median) + " m must be smaller than body.radius = " + num(R) + " m");
+  return RadiusDistribution::lognormal(*median, *sigma);
+}
+
+// distribution = "levels": radii with their fractions (the exact level law, theory_radii.hpp).
+RadiusDistribution read_radius_levels(Reader& rad, const Scene& s, double R) {
+  const auto radii = rad.reals("radii");
+  const auto fractions = rad.reals("fractions");
+  if (radii) {
+    for (double r : *radii)
+      if (!(r >= kMinLength && r <= kMaxLength))
+        rad.bad("radii", "every radius must be in [" + num(kMinLength) + ", " + num(kMaxLength) +
+                             "] m (supported range), got " + num(r));
+    if (radii->size() > kMaxRadiusLevels)
+      rad.bad("radii", "at most " + std::to_string(kMaxRadiusLevels) + " levels, got " +
+                           std::to_string(radii->size()) + " (the exact level law costs ~levels^3 per point)");
+  }
+  if (fractions) {
+    double sum = 0;
+    for (double f : *fractions) {
+      if (!(f > 0)) rad.bad("fractions", "every fraction must be > 0, got " + num(f));
+      sum += f;
+    }
+    if (std::abs(sum - 1.0) > 1e-9) rad.bad("fractions", "must sum to 1, got " + num(sum));
+  }
+  if (!radii) rad.missing("radii", "the level radii [m], e.g. [1.3e-6, 6.5e-7]");
+  if (!fractions) rad.missing("fractions", "one probability per radius, summing to 1, e.g. [0.2, 0.8]");
+  if (radii->size() != fractions->size())
+    rad.bad("fractions", "needs one fraction per radius (" + std::to_string(radii->size()) + "), got " +
+                             std::to_string(fractions->size()));
+  if (!s.mesh)
+    for (double r : *radii)
+      if (r >= R) rad.bad("radii", num(r) + " m must be smaller than body.radius = " + num(R) + " m");
+  return RadiusDistribution::discrete(*radii, *fractions);
+}
+
+// asperities.radius: "fixed" sets the one radius; "lognormal" and "levels" make a radii run.
+void read_asperity_radius(Reader& rad, Scene& s, double R) {
+  const auto dist = rad.choice("distribution", {"fixed", "lognormal", "levels"});
+  if (!dist) rad.missing("distribution", "\"fixed\" (with value), \"lognormal\" or \"levels\"");
+  if (*dist == "fixed") read_fixed_radius(rad, s, R);
+  else if (*dist == "lognormal") s.radii = RadiiScene{read_lognormal_radius(rad, s, R)};
+  else s.radii = RadiiScene{read_radius_levels(rad, s, R)};
+  rad.finish();
+}
+
+// [asperities]; then the sphere must be larger than its asperities.
+void read_asperities(Reader& top, Scene& s) {
+  const double R = s.ensemble.sphere.radius;
   if (auto asp = top.table("asperities")) {
-    const auto n = asp->count("count", 1, kMaxAsperities);
-    const auto eta = asp->positive("areal_density", "per m^2");
-    if (n && eta) asp->bad("areal_density", "give either count or areal_density, not both");
-    if (eta && s.mesh) asp->bad("areal_density", "a mesh body needs count (N per body), got areal_density = " + num(*eta));
-    if (n) s.ensemble.sphere.asperities = *n;
-    if (eta) {
-      const double count = std::round(*eta * 4.0 * std::numbers::pi * R * R);
-      if (!(count >= 1) || count > double(kMaxAsperities))
-        asp->bad("areal_density", num(*eta) + " per m^2 on a sphere of radius " + num(R) + " m gives " + num(count) +
-                                      " asperities; need 1 .. 2^32-1");
-      s.ensemble.sphere.asperities = static_cast<std::uint64_t>(count);
-    }
-    if (auto rad = asp->table("radius")) {
-      const auto dist = rad->choice("distribution", {"fixed", "lognormal", "levels"});
-      if (!dist) rad->missing("distribution", "\"fixed\" (with value), \"lognormal\" or \"levels\"");
-      if (*dist == "fixed") {
-        const auto a = rad->positive("value", "m");
-        if (!a) rad->missing("value", "the asperity radius a [m]");
-        if (!(*a >= kMinLength && *a <= kMaxLength))
-          rad->bad("value", "must be in [" + num(kMinLength) + ", " + num(kMaxLength) + "] m (supported range), got " +
-                                num(*a));
-        if (!s.mesh && *a >= R) rad->bad("value", num(*a) + " m must be smaller than body.radius = " + num(R) + " m");
-        s.ensemble.sphere.asperity_radius = *a;
-      } else if (*dist == "lognormal") {
-        const auto median = rad->positive("median", "m");
-        if (!median) rad->missing("median", "the median asperity radius exp(mu) [m]");
-        if (!(*median >= kMinLength && *median <= kMaxLength))
-          rad->bad("median", "must be in [" + num(kMinLength) + ", " + num(kMaxLength) + "] m (supported range), got " +
-                                 num(*median));
-        const auto sigma = rad->real("sigma");
-        if (!sigma) rad->missing("sigma", "the standard deviation of ln(radius), e.g. 0.3");
-        if (*sigma < 0) rad->bad("sigma", "must be >= 0, got " + num(*sigma));
-        if (!s.mesh && *median >= R) rad->bad("median", num(*median) + " m must be smaller than body.radius = " + num(R) + " m");
-        s.radii = RadiiScene{RadiusDistribution::lognormal(*median, *sigma)};
-      } else {
-        const auto radii = rad->reals("radii");
-        const auto fractions = rad->reals("fractions");
-        if (radii) {
-          for (double r : *radii)
-            if (!(r >= kMinLength && r <= kMaxLength))
-              rad->bad("radii", "every radius must be in [" + num(kMinLength) + ", " + num(kMaxLength) +
-                                    "] m (supported range), got " + num(r));
-          if (radii->size() > kMaxRadiusLevels)
-            rad->bad("radii", "at most " + std::to_string(kMaxRadiusLevels) + " levels, got " +
-                                  std::to_string(radii->size()) + " (the exact level law costs ~levels^3 per point)");
-        }
-        if (fractions) {
-          double sum = 0;
-          for (double f : *fractions) {
-            if (!(f > 0)) rad->bad("fractions", "every fraction must be > 0, got " + num(f));
-            sum += f;
-          }
-          if (std::abs(sum - 1.0) > 1e-9) rad->bad("fractions", "must sum to 1, got " + num(sum));
-        }
-        if (!radii) rad->missing("radii", "the level radii [m], e.g. [1.3e-6, 6.5e-7]");
-        if (!fractions) rad->missing("fractions", "one probability per radius, summing to 1, e.g. [0.2, 0.8]");
-        if (radii->size() != fractions->size())
-          rad->bad("fractions", "needs one fraction per radius (" + std::to_string(radii->size()) + "), got " +
-                                    std::to_string(fractions->size()));
-        if (!s.mesh)
-          for (double r : *radii)
-            if (r >= R) rad->bad("radii", num(r) + " m must be smaller than body.radius = " + num(R) + " m");
-        s.radii = RadiiScene{RadiusDistribution::discrete(*radii, *fractions)};
-      }
-      rad->finish();
-    }
+    read_asperity_count(*asp, s, R);
+    if (auto rad = asp->table("radius")) read_asperity_radius(*rad, s, R);
     asp->finish();
   }
   if (!s.mesh && s.ensemble.sphere.asperity_radius >= R)
     top.fail(nullptr, "body.radius",
              "body.radius: " + num(R) + " m must exceed the asperity radius " + num(s.ensemble.sphere.asperity_radius) + " m");
+}
 
-  // [ensemble]
+// ensemble.mode. Earlier names: "fixed" is "explicit"; "fresh" is "explicit" (the paper's sphere:
+// validated from geometry, with a note) or "sampled" (unequal radii: their exact sampler, as before).
+void read_mode(Reader& ens, Scene& s) {
   auto& e = s.ensemble;
-  if (auto ens = top.table("ensemble")) {
-    // Earlier names: "fixed" is "explicit"; "fresh" is "explicit" (the paper's sphere: validated from
-    // geometry, with a note) or "sampled" (unequal radii: their exact sampler, as before).
-    if (auto m = ens->choice("mode", {"explicit", "sampled", "fresh", "fixed"})) {
-      e.mode = parse_mode(*m);
-      if (*m == "fresh" && s.radii && !s.mesh) e.mode = Mode::sampled;
-      else if (is_legacy_mode(*m)) s.legacy_mode = *m;
-    } else if (s.radii && !s.mesh) {
-      e.mode = Mode::sampled;  // unequal radii on a sphere: the exact sampler is their only design
-    }
-    if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
-    const toml::node* k_node = ens->has("spheres") ? ens->find("spheres") : nullptr;
-    if (k_node && k_node->as_string() && k_node->as_string()->get() == "auto") {
-      s.spheres_auto = true;
-    } else if (auto k = ens->count("spheres", 1, kMaxDrops)) {
-      if (e.mode == Mode::sampled && *k != 1)
-        ens->bad("spheres", "only mode = \"explicit\" uses explicit spheres (sampled draws from the exact law, no sphere), "
-                            "got " + std::to_string(*k));
-      e.spheres = *k;
-      s.spheres_auto = e.mode != Mode::explicit_spheres;
-    }
-    if (e.mode == Mode::explicit_spheres && !s.spheres_auto && e.drops % e.spheres != 0)
-      ens->bad("drops", std::to_string(e.drops) + " must be a multiple of ensemble.spheres = " + std::to_string(e.spheres));
-    if (const toml::node* seed = ens->find("seed")) {
-      // Integers up to 2^63 - 1; larger 64-bit seeds as a string of digits.
-      if (auto i = seed->as_integer()) {
-        if (i->get() < 0) ens->bad("seed", "must be >= 0, got " + show(*seed));
-        e.seed = static_cast<std::uint64_t>(i->get());
-      } else if (auto str = seed->as_string()) {
-        const std::string& t = str->get();
-        const auto res = std::from_chars(t.data(), t.data() + t.size(), e.seed);
-        if (t.empty() || res.ec != std::errc() || res.ptr != t.data() + t.size())
-          ens->bad("seed", "expected a non-negative 64-bit integer, got " + show(*seed));
-      } else {
-        ens->bad("seed", "expected a non-negative integer, got " + show(*seed) + " (" + type_name(*seed) + ")");
-      }
-    }
-    if (auto b = ens->choice("backend", {"auto", "brute", "kdtree", "cgal", "fcl", "grid"})) {
-      s.backend_auto = *b == "auto";
-      if (!s.backend_auto) e.backend = parse_backend(*b);
-      if (e.mode == Mode::sampled && !s.backend_auto)  // a key that cannot apply is refused, never ignored
-        ens->bad("backend", "only mode = \"explicit\" queries a contact index (sampled draws the lowest asperities "
-                            "from the exact law): \"auto\" or absent, got \"" + *b + "\"");
-    }
-    if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
-    ens->finish();
+  if (auto m = ens.choice("mode", {"explicit", "sampled", "fresh", "fixed"})) {
+    e.mode = parse_mode(*m);
+    if (*m == "fresh" && s.radii && !s.mesh) e.mode = Mode::sampled;
+    else if (is_legacy_mode(*m)) s.legacy_mode = *m;
+  } else if (s.radii && !s.mesh) {
+    e.mode = Mode::sampled;  // unequal radii on a sphere: the exact sampler is their only design
   }
+}
 
-  // Mesh bodies and unequal radii are runs of body_experiments.hpp: explicit bodies with the exact
-  // support tree, so the ensemble keys that choose a contact backend or a mode do not apply.
-  // Bodies, radii and bounce runs choose their own number of bodies: K is never automatic there.
+// ensemble.spheres: a count, or "auto" (the planner takes K from the error budget).
+void read_spheres(Reader& ens, Scene& s) {
+  auto& e = s.ensemble;
+  const toml::node* k_node = ens.has("spheres") ? ens.find("spheres") : nullptr;
+  if (k_node && k_node->as_string() && k_node->as_string()->get() == "auto") {
+    s.spheres_auto = true;
+  } else if (auto k = ens.count("spheres", 1, kMaxDrops)) {
+    if (e.mode == Mode::sampled && *k != 1)
+      ens.bad("spheres", "only mode = \"explicit\" uses explicit spheres (sampled draws from the exact law, no sphere), "
+                         "got " + std::to_string(*k));
+    e.spheres = *k;
+    s.spheres_auto = e.mode != Mode::explicit_spheres;
+  }
+}
+
+// ensemble.seed: integers up to 2^63 - 1; larger 64-bit seeds as a string of digits.
+void read_seed(Reader& ens, std::uint64_t& seed_out) {
+  const toml::node* seed = ens.find("seed");
+  if (!seed) return;
+  if (auto i = seed->as_integer()) {
+    if (i->get() < 0) ens.bad("seed", "must be >= 0, got " + show(*seed));
+    seed_out = static_cast<std::uint64_t>(i->get());
+  } else if (auto str = seed->as_string()) {
+    const std::string& t = str->get();
+    const auto res = std::from_chars(t.data(), t.data() + t.size(), seed_out);
+    if (t.empty() || res.ec != std::errc() || res.ptr != t.data() + t.size())
+      ens.bad("seed", "expected a non-negative 64-bit integer, got " + show(*seed));
+  } else {
+    ens.bad("seed", "expected a non-negative integer, got " + show(*seed) + " (" + type_name(*seed) + ")");
+  }
+}
+
+void read_backend(Reader& ens, Scene& s) {
+  auto& e = s.ensemble;
+  if (auto b = ens.choice("backend", {"auto", "brute", "kdtree", "cgal", "fcl", "grid"})) {
+    s.backend_auto = *b == "auto";
+    if (!s.backend_auto) e.backend = parse_backend(*b);
+    if (e.mode == Mode::sampled && !s.backend_auto)  // a key that cannot apply is refused, never ignored
+      ens.bad("backend", "only mode = \"explicit\" queries a contact index (sampled draws the lowest asperities "
+                         "from the exact law): \"auto\" or absent, got \"" + *b + "\"");
+  }
+}
+
+// [ensemble]
+void read_ensemble(Reader& top, Scene& s) {
+  auto ens = top.table("ensemble");
+  if (!ens) return;
+  auto& e = s.ensemble;
+  read_mode(*ens, s);
+  if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
+  read_spheres(*ens, s);
+  if (e.mode == Mode::explicit_spheres && !s.spheres_auto && e.drops % e.spheres != 0)
+    ens->bad("drops", std::to_string(e.drops) + " must be a multiple of ensemble.spheres = " + std::to_string(e.spheres));
+  read_seed(*ens, e.seed);
+  read_backend(*ens, s);
+  if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
+  ens->finish();
+}
+
+// Mesh bodies and unequal radii are runs of body_experiments.hpp: explicit bodies with the exact
+// support tree, so the ensemble keys that choose a contact backend or a mode do not apply.
+// Bodies, radii and bounce runs choose their own number of bodies: K is never automatic there.
+void check_body_ensemble(Reader& top, Scene& s) {
+  const auto& e = s.ensemble;
   if (s.mesh || s.radii || s.bounce.enabled) s.spheres_auto = false;
   if (s.mesh && e.mode != Mode::explicit_spheres)
     top.fail(nullptr, "ensemble.mode",
@@ -508,8 +602,10 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     top.fail(nullptr, "ensemble.backend",
              "ensemble.backend: mesh bodies and unequal asperity radii use the exact support tree; only \"auto\", got \"" +
                  std::string(to_string(e.backend)) + "\"");
+}
 
-  // [screening]: unequal radii (sphere: lambda_eff of run_radii_experiment; mesh: screen_body).
+// [screening]: unequal radii (sphere: lambda_eff of run_radii_experiment; mesh: screen_body).
+void read_screening(Reader& top, Scene& s) {
   if (auto scr = top.table("screening")) {
     if (!s.radii)
       scr->fail(nullptr, "screening", "screening: only for unequal asperity radii (asperities.radius distribution "
@@ -519,82 +615,107 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     scr->finish();
   }
   if (s.radii && !s.mesh && s.radii->radii.kind == RadiusDistribution::Kind::lognormal &&
-      e.drops % s.radii->screen_bodies != 0)
+      s.ensemble.drops % s.radii->screen_bodies != 0)
     top.fail(nullptr, "ensemble.drops",
-             "ensemble.drops: " + std::to_string(e.drops) + " must be a multiple of screening.bodies = " +
+             "ensemble.drops: " + std::to_string(s.ensemble.drops) + " must be a multiple of screening.bodies = " +
                  std::to_string(s.radii->screen_bodies) + " (lognormal radii: r_x comes from rotations of the screened bodies)");
+}
 
-  // [experiment]
-  bool impacts = false;
-  if (auto ex = top.table("experiment")) {
-    const auto kind = ex->choice("kind", {"contact", "impact", "bounce"}).value_or("contact");
-    impacts = kind == "impact";
-    if (kind == "bounce") {
-      // Sec. V: sequences of impacts from `speed` down to `stop_speed`, Omega = 0 at the start.
-      s.bounce.enabled = true;
-      if (auto u = ex->positive("speed", "m/s")) s.bounce.speed = *u;
-      if (auto u = ex->positive("stop_speed", "m/s")) s.bounce.stop_speed = *u;
-      if (auto g = ex->positive("gravity", "m/s^2")) s.bounce.gravity = *g;
-      if (auto n = ex->count("sequences", 1, std::uint64_t{1} << 31)) s.bounce.sequences = *n;
-      if (auto v = ex->text("variants")) {
-        s.bounce.variants.clear();
-        std::size_t pos = 0;
-        try {
-          do {
-            const std::size_t comma = v->find(',', pos);
-            const BounceVariant b = parse_bounce_variant(v->substr(pos, comma - pos));
-            if (std::find(s.bounce.variants.begin(), s.bounce.variants.end(), b) != s.bounce.variants.end())
-              ex->bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(*v) +
-                                      " (a variant compared with itself decides nothing)");
-            s.bounce.variants.push_back(b);
-            pos = comma == std::string::npos ? comma : comma + 1;
-          } while (pos != std::string::npos);
-        } catch (const std::invalid_argument& err) {
-          ex->bad("variants", err.what());
-        }
-      }
-      // Groups of the analysis (defaults: bounce.hpp), e.g. to match an experiment's impact speeds.
-      if (auto w = ex->pairs("speed_windows")) s.bounce.windows = *w;
-      if (auto g = ex->reals("impact_groups")) {
-        s.bounce.impact_numbers.clear();
-        for (double k : *g) {
-          if (!(k >= 1) || k != std::floor(k) || k > 1e9) ex->bad("impact_groups", "impact numbers are whole numbers >= 1, got " + num(k));
-          s.bounce.impact_numbers.push_back(static_cast<unsigned>(k));
-        }
-      }
-      if (!(s.bounce.stop_speed < s.bounce.speed))
-        ex->bad("stop_speed", "must be below speed = " + num(s.bounce.speed) + " m/s, got " + num(s.bounce.stop_speed));
-      // A body bounces one way: its orientation carried by the free rotation (body_bounce.hpp).
-      if (s.mesh) {
-        if (ex->has("variants") && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
-          ex->bad("variants", "a mesh body bounces with its orientation carried by the free rotation: only \"dynamic\"");
-        s.bounce.variants = {BounceVariant::dynamic};
-        if (const auto W = ex->vec3("Omega", "rad/s")) s.bounce.omega = *W;
-      } else if (ex->has("Omega")) {
-        ex->bad("Omega", "only for body.kind = \"mesh\": the sphere's bounce variants start without spin (Sec. V)");
-      }
-    } else {
-      for (const char* k : {"speed", "stop_speed", "gravity", "sequences", "variants", "speed_windows", "impact_groups"})
-        if (ex->has(k)) ex->bad(k, "only for kind = \"bounce\"");
-    }
-    if (impacts) {
-      const auto V = ex->vec3("V", "m/s");
-      const auto Omega = ex->vec3("Omega", "rad/s");
-      if (!V) ex->missing("V", "velocity before the impact [m/s], e.g. [0, 0, -1.3]");
-      if (!Omega) ex->missing("Omega", "spin before the impact [rad/s], e.g. [0.2, 0, 0]");
-      if (!((*V)[2] < 0)) ex->bad("V", "the body must approach the plate below it (V.z < 0), got V.z = " + num((*V)[2]));
-      if ((*V)[0] != 0 || (*V)[1] != 0)
-        ex->unsupported("V", "only vertical impacts V = [0, 0, -u] are in the engine yet");
-      impact.speed = -(*V)[2];
-      impact.omega = *Omega;
-    } else {
-      for (const char* k : {"V", "Omega"})
-        if (ex->has(k) && !(s.bounce.enabled && s.mesh && std::string(k) == "Omega"))
-          ex->bad(k, s.bounce.enabled ? "only for kind = \"impact\" (a bounce starts at V = [0, 0, -speed])"
-                                      : "only for kind = \"impact\"");
-    }
-    ex->finish();
+// experiment.variants = "paper,dynamic,...": each variant once.
+std::vector<BounceVariant> read_bounce_variants(Reader& ex, const std::string& v) {
+  std::vector<BounceVariant> variants;
+  std::size_t pos = 0;
+  try {
+    do {
+      const std::size_t comma = v.find(',', pos);
+      const BounceVariant b = parse_bounce_variant(v.substr(pos, comma - pos));
+      if (std::find(variants.begin(), variants.end(), b) != variants.end())
+        ex.bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(v) +
+                               " (a variant compared with itself decides nothing)");
+      variants.push_back(b);
+      pos = comma == std::string::npos ? comma : comma + 1;
+    } while (pos != std::string::npos);
+  } catch (const std::invalid_argument& err) {
+    ex.bad("variants", err.what());
   }
+  return variants;
+}
+
+// The groups of the bounce analysis (defaults: bounce.hpp), e.g. to match an experiment's impact speeds.
+void read_bounce_groups(Reader& ex, BounceExperiment& b) {
+  if (auto w = ex.pairs("speed_windows")) b.windows = *w;
+  if (auto g = ex.reals("impact_groups")) {
+    b.impact_numbers.clear();
+    for (double k : *g) {
+      if (!(k >= 1) || k != std::floor(k) || k > 1e9) ex.bad("impact_groups", "impact numbers are whole numbers >= 1, got " + num(k));
+      b.impact_numbers.push_back(static_cast<unsigned>(k));
+    }
+  }
+}
+
+// kind = "bounce" (Sec. V): sequences of impacts from `speed` down to `stop_speed`, Omega = 0 at the start.
+void read_bounce(Reader& ex, Scene& s) {
+  auto& b = s.bounce;
+  b.enabled = true;
+  if (auto u = ex.positive("speed", "m/s")) b.speed = *u;
+  if (auto u = ex.positive("stop_speed", "m/s")) b.stop_speed = *u;
+  if (auto g = ex.positive("gravity", "m/s^2")) b.gravity = *g;
+  if (auto n = ex.count("sequences", 1, std::uint64_t{1} << 31)) b.sequences = *n;
+  if (auto v = ex.text("variants")) b.variants = read_bounce_variants(ex, *v);
+  read_bounce_groups(ex, b);
+  if (!(b.stop_speed < b.speed))
+    ex.bad("stop_speed", "must be below speed = " + num(b.speed) + " m/s, got " + num(b.stop_speed));
+  // A body bounces one way: its orientation carried by the free rotation (body_bounce.hpp).
+  if (s.mesh) {
+    if (ex.has("variants") && b.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
+      ex.bad("variants", "a mesh body bounces with its orientation carried by the free rotation: only \"dynamic\"");
+    b.variants = {BounceVariant::dynamic};
+    if (const auto W = ex.vec3("Omega", "rad/s")) b.omega = *W;
+  } else if (ex.has("Omega")) {
+    ex.bad("Omega", "only for body.kind = \"mesh\": the sphere's bounce variants start without spin (Sec. V)");
+  }
+}
+
+// kind = "impact": one vertical impact at V with spin Omega.
+void read_impact(Reader& ex, ImpactExperiment& impact) {
+  const auto V = ex.vec3("V", "m/s");
+  const auto Omega = ex.vec3("Omega", "rad/s");
+  if (!V) ex.missing("V", "velocity before the impact [m/s], e.g. [0, 0, -1.3]");
+  if (!Omega) ex.missing("Omega", "spin before the impact [rad/s], e.g. [0.2, 0, 0]");
+  if (!((*V)[2] < 0)) ex.bad("V", "the body must approach the plate below it (V.z < 0), got V.z = " + num((*V)[2]));
+  if ((*V)[0] != 0 || (*V)[1] != 0)
+    ex.unsupported("V", "only vertical impacts V = [0, 0, -u] are in the engine yet");
+  impact.speed = -(*V)[2];
+  impact.omega = *Omega;
+}
+
+// [experiment]: contact (default), impact or bounce; returns whether it has single impacts.
+bool read_experiment(Reader& top, Scene& s) {
+  auto ex = top.table("experiment");
+  if (!ex) return false;
+  const auto kind = ex->choice("kind", {"contact", "impact", "bounce"}).value_or("contact");
+  const bool impacts = kind == "impact";
+  if (kind == "bounce") {
+    read_bounce(*ex, s);
+  } else {
+    for (const char* k : {"speed", "stop_speed", "gravity", "sequences", "variants", "speed_windows", "impact_groups"})
+      if (ex->has(k)) ex->bad(k, "only for kind = \"bounce\"");
+  }
+  if (impacts) {
+    read_impact(*ex, s.ensemble.impact);
+  } else {
+    for (const char* k : {"V", "Omega"})
+      if (ex->has(k) && !(s.bounce.enabled && s.mesh && std::string(k) == "Omega"))
+        ex->bad(k, s.bounce.enabled ? "only for kind = \"impact\" (a bounce starts at V = [0, 0, -speed])"
+                                    : "only for kind = \"impact\"");
+  }
+  ex->finish();
+  return impacts;
+}
+
+// Which bodies can run which experiment; the bounce takes the material of every impact.
+void check_experiment(Reader& top, Scene& s, bool impacts) {
+  auto& impact = s.ensemble.impact;
   impact.enabled = impacts;
   if (s.bounce.enabled || s.mesh) s.spheres_auto = false, s.legacy_mode.clear();  // their own designs
   if (s.mesh && !impacts && !s.bounce.enabled)
@@ -608,49 +729,63 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   if (s.bounce.enabled) {  // the material applies to every impact of a sequence
     s.bounce.density = impact.density, s.bounce.beta = impact.beta, s.bounce.eps_t = impact.eps_t;
   }
+}
 
-  // [outputs]
-  if (auto out = top.table("outputs")) {
-    if (auto c = out->boolean("contact")) s.contact_stats = *c;
-    if (auto r = out->boolean("restitution")) {
-      if (*r && !impacts && !s.bounce.enabled)
-        out->bad("restitution", "true needs experiment.kind = \"impact\" or \"bounce\"");
-      s.restitution_stats = *r;
-    }
-    if (!s.bounce.enabled && !s.contact_stats && !(impacts && s.restitution_stats))
-      out->bad("contact", "nothing to compute: request contact = true, or restitution = true with an impact experiment");
-    if (auto p = out->boolean("plots")) s.plots = *p;
-    if (auto a = out->real("alpha")) {
-      if (!(*a > 0 && *a < 1)) out->bad("alpha", "must be in (0, 1), got " + num(*a));
-      s.alpha = *a;
-    }
-    if (auto d = out->text("dir")) s.out = *d;
-    if (auto r = out->text("report")) {
-      if (const std::string why = output_name_problem(*r); !why.empty())
-        out->bad("report", "must be a plain file name inside outputs.dir, got " + quote(*r) + ": it " + why);
-      s.report = *r;
-    }
-    if (auto p = out->text("export_ply")) {
-      if (!s.mesh) out->bad("export_ply", "only for body.kind = \"mesh\"");
-      if (const std::string why = output_name_problem(*p); !why.empty())
-        out->bad("export_ply", "must be a plain file name inside outputs.dir, got " + quote(*p) + ": it " + why);
-      if (*p == s.report || *p == report_table_name(s.report))
-        out->bad("export_ply", quote(*p) + " is also the name of the report or its table (" + quote(s.report) + ", " +
-                                   quote(report_table_name(s.report)) + ")");
-      s.mesh->export_ply = *p;
-    }
-    if (auto st = out->choice("export_style", {"spheres", "points"})) {
-      if (!s.mesh || s.mesh->export_ply.empty()) out->bad("export_style", "only with outputs.export_ply");
-      s.mesh->export_points = *st == "points";
-    }
-    if (s.mesh && !(s.contact_stats && s.restitution_stats))
-      out->bad(s.contact_stats ? "restitution" : "contact", "a mesh body's run always analyses contacts and restitution");
-    out->finish();
+// outputs.report and outputs.export_ply/export_style: plain names inside outputs.dir.
+void read_output_files(Reader& out, Scene& s) {
+  if (auto r = out.text("report")) {
+    if (const std::string why = output_name_problem(*r); !why.empty())
+      out.bad("report", "must be a plain file name inside outputs.dir, got " + quote(*r) + ": it " + why);
+    s.report = *r;
   }
-  top.finish();
+  if (auto p = out.text("export_ply")) {
+    if (!s.mesh) out.bad("export_ply", "only for body.kind = \"mesh\"");
+    if (const std::string why = output_name_problem(*p); !why.empty())
+      out.bad("export_ply", "must be a plain file name inside outputs.dir, got " + quote(*p) + ": it " + why);
+    if (*p == s.report || *p == report_table_name(s.report))
+      out.bad("export_ply", quote(*p) + " is also the name of the report or its table (" + quote(s.report) + ", " +
+                                quote(report_table_name(s.report)) + ")");
+    s.mesh->export_ply = *p;
+  }
+  if (auto st = out.choice("export_style", {"spheres", "points"})) {
+    if (!s.mesh || s.mesh->export_ply.empty()) out.bad("export_style", "only with outputs.export_ply");
+    s.mesh->export_points = *st == "points";
+  }
+}
 
-  // The engine's own checks, as a net: the keys above should already have caught everything.
-  // A message that starts with a dotted key ("ensemble.drops (--drops): ...") points at its line.
+// [outputs]: what to analyse and where to write it.
+void read_outputs(Reader& top, Scene& s, bool impacts) {
+  auto out = top.table("outputs");
+  if (!out) return;
+  if (auto c = out->boolean("contact")) s.contact_stats = *c;
+  if (auto r = out->boolean("restitution")) {
+    if (*r && !impacts && !s.bounce.enabled)
+      out->bad("restitution", "true needs experiment.kind = \"impact\" or \"bounce\"");
+    s.restitution_stats = *r;
+  }
+  if (!s.bounce.enabled && !s.contact_stats && !(impacts && s.restitution_stats))
+    out->bad("contact", "nothing to compute: request contact = true, or restitution = true with an impact experiment");
+  if (auto p = out->boolean("plots")) s.plots = *p;
+  if (auto a = out->real("alpha")) {
+    if (!(*a > 0 && *a < 1)) out->bad("alpha", "must be in (0, 1), got " + num(*a));
+    s.alpha = *a;
+  }
+  if (auto d = out->text("dir")) s.out = *d;
+  read_output_files(*out, s);
+  if (s.mesh && !(s.contact_stats && s.restitution_stats))
+    out->bad(s.contact_stats ? "restitution" : "contact", "a mesh body's run always analyses contacts and restitution");
+  if (auto ct = out->table("cor_table")) {
+    if (s.mesh || s.radii || s.bounce.enabled || !impacts)
+      out->bad("cor_table", "only for a sphere impact scene (body.kind = \"sphere\", experiment.kind = \"impact\", "
+                            "one asperity radius)");
+    s.cor_table = read_cor_table(*ct);
+  }
+  out->finish();
+}
+
+// The engine's own checks, as a net: the keys read above should already have caught everything.
+// A message that starts with a dotted key ("ensemble.drops (--drops): ...") points at its line.
+void validate_at_lines(const Reader& top, const toml::table& root, const Scene& s) {
   try {
     validate(s);
   } catch (const std::invalid_argument& ex) {
@@ -659,6 +794,25 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     const toml::node* at = key.find('.') != std::string::npos ? root.at_path(key).node() : nullptr;
     top.fail(at, at ? key : "", what);
   }
+}
+
+// The tables in this order: a later table's rules may depend on an earlier one (body -> radii ->
+// mode -> experiment -> outputs), and the first error found is the one reported.
+Scene scene_from_toml(const toml::table& root, std::string_view origin) {
+  Reader top(root, "", origin);
+  Scene s;
+  read_header(top, s);
+  read_body(top, s);
+  read_material(top, s);
+  read_asperities(top, s);
+  read_ensemble(top, s);
+  check_body_ensemble(top, s);
+  read_screening(top, s);
+  const bool impacts = read_experiment(top, s);
+  check_experiment(top, s, impacts);
+  read_outputs(top, s, impacts);
+  top.finish();
+  validate_at_lines(top, root, s);
   return s;
 }
 
@@ -889,6 +1043,22 @@ std::string to_toml(const Scene& s) {
   if (s.mesh && !s.mesh->export_ply.empty())
     os << "export_ply = " << quote(s.mesh->export_ply) << "\nexport_style = \""
        << (s.mesh->export_points ? "points" : "spheres") << "\"\n";
+  if (s.cor_table) {
+    const CorTableScene& c = *s.cor_table;
+    os << "\n[outputs.cor_table]\nfile = " << quote(c.file) << "\n";
+    if (!c.speeds.empty()) {
+      os << "speeds = [";
+      for (std::size_t i = 0; i < c.speeds.size(); ++i) os << (i ? ", " : "") << num(c.speeds[i]);
+      os << "]\n";
+    }
+    os << "probabilities = " << c.probabilities << "\ndrops = " << c.drops << "\n";
+    if (!c.spins.empty()) {
+      os << "spins = [";
+      for (std::size_t i = 0; i < c.spins.size(); ++i) os << (i ? ", " : "") << num(c.spins[i]);
+      os << "]\n";
+    }
+    if (c.omega_bands > 0) os << "omega_bands = " << c.omega_bands << "\n";
+  }
   return os.str();
 }
 

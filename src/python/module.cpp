@@ -618,7 +618,7 @@ without an impact (v_n >= 0) are NaN with impact False.)doc");
   m.def(
       "cor_table",
       [](const py::handle& scene, const py::object& speeds, std::size_t probabilities, const py::object& drops,
-         const py::object& path, const py::object& progress) {
+         const py::object& path, const py::object& progress, const py::object& spins, std::size_t omega_bands) {
         check_callable(progress);
         CorTableSpec spec = cor_table_spec(to_scene(scene));
         try {
@@ -626,6 +626,12 @@ without an impact (v_n >= 0) are NaN with impact False.)doc");
         } catch (const py::cast_error&) {
           value_error("speeds: expected a sequence of numbers [m/s], got " + show(speeds));
         }
+        try {
+          if (!spins.is_none()) spec.spins = spins.cast<std::vector<double>>();
+        } catch (const py::cast_error&) {
+          value_error("spins: expected a sequence of numbers [rad/s], got " + show(spins));
+        }
+        spec.omega_bands = omega_bands;
         spec.probabilities = probabilities;
         if (!drops.is_none()) {
           if (!py::isinstance<py::int_>(drops) || drops.cast<py::int_>() < py::int_(0))
@@ -647,18 +653,32 @@ without an impact (v_n >= 0) are NaN with impact False.)doc");
         py::dict out = py::module_::import("json").attr("loads")(cor_table_json(t));
         out["speeds"] = to_numpy(std::vector<double>(spec.speeds));
         out["p"] = to_numpy(std::vector<double>(t.probabilities));
-        out["quantiles"] = to_numpy(std::move(q)).reshape({static_cast<py::ssize_t>(t.rows.size()), static_cast<py::ssize_t>(t.probabilities.size())});
+        const auto P = static_cast<py::ssize_t>(t.probabilities.size()), S = static_cast<py::ssize_t>(spec.speeds.size());
+        if (t.format() == 1) {
+          out["quantiles"] = to_numpy(std::move(q)).reshape({S, P});
+        } else {  // (spins, speeds, p) and, with omega_bands, (spins, speeds, bands, p)
+          const auto K = static_cast<py::ssize_t>(t.rows.size()) / S;
+          out["quantiles"] = to_numpy(std::move(q)).reshape({K, S, P});
+          std::vector<double> w;
+          for (const auto& row : t.rows)
+            for (const auto& band : row.omega_x_band_quantiles) w.insert(w.end(), band.begin(), band.end());
+          out["omega_band_quantiles"] = to_numpy(std::move(w)).reshape({K, S, static_cast<py::ssize_t>(spec.omega_bands), P});
+        }
         py::list written;
         for (const auto& f : files) written.append(f.string());
         out["files"] = written;
         return out;
       },
       py::arg("scene") = "fig4", py::arg("speeds") = py::none(), py::arg("probabilities") = 201, py::arg("drops") = py::none(),
-      py::arg("path") = py::none(), py::arg("progress") = py::none(),
+      py::arg("path") = py::none(), py::arg("progress") = py::none(), py::arg("spins") = py::none(),
+      py::arg("omega_bands") = 0,
       R"doc(A restitution table for DEM codes (app/cor_table.hpp; README "Restitution tables").
 
 The sphere, material, spin and seed come from `scene` (a sphere impact scene); speeds [m/s]
 default to 9 points from u/10 to 10 u around its impact speed u; drops per speed (sampled from the exact law of the lowest asperity)
 default to 1e5. Returns the JSON header as a dict plus arrays speeds, p, quantiles (speeds x p);
-with path, writes path (CSV) and the .json next to it (files lists them).)doc");
+with path, writes path (CSV) and the .json next to it (files lists them). spins [rad/s] (incoming
+Omega = (spin, 0, 0)) and/or omega_bands (Omega'_x quantiles per eps band, for joint draws) make a
+format-2 table: quantiles then has shape (spins, speeds, p) and omega_band_quantiles
+(spins, speeds, bands, p).)doc");
 }

@@ -69,3 +69,18 @@ def test_c_header_reads_the_table(tmp_path):
     assert "3 speeds x 11 probabilities" in r.stdout
     # The C sampler at the first speed and u = 0.5 is the median column.
     assert float(r.stdout.split("=")[-1]) == pytest.approx(t["quantiles"][0, 5], abs=1e-6)
+
+
+def test_spin_grid_and_omega_bands(tmp_path):
+    path = tmp_path / "spins.csv"
+    t = small(spins=[-1.0, 0.0, 1.0], omega_bands=5, path=path)
+    assert t["format_version"] == 2 and t["spins_rad_s"] == [-1.0, 0.0, 1.0]
+    assert t["quantiles"].shape == (3, 3, 11)
+    assert t["omega_band_quantiles"].shape == (3, 3, 5, 11)
+    lines = [l for l in path.read_text().splitlines() if not l.startswith("#")]
+    assert lines[0].startswith("spin_rad_s,speed_m_s,row,p=0")
+    assert len(lines) == 1 + 3 * 3 * (1 + 5)
+    with pytest.raises(ValueError, match="spins"):
+        small(spins=[1.0, -1.0])
+    with pytest.raises(ValueError, match="omega_bands"):
+        small(omega_bands=5000)

@@ -99,6 +99,8 @@ struct ReportHeader {
   std::string scene_toml;               ///< the effective scene as a scene file (to_toml); empty: omitted
   std::vector<PlanStage> plan;          ///< empty: omitted
   std::vector<std::pair<std::string, double>> timings_s;  ///< wall seconds per stage; empty: omitted
+  /// Further top-level objects (name, JSON text), e.g. "cor_table" for outputs.cor_table.
+  std::vector<std::pair<std::string, std::string>> sections;
 };
 
 /// `body` (a JSON object, as the to_json functions return it) with the header fields set:

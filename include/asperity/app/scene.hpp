@@ -32,6 +32,22 @@ struct MeshBodyScene {
   friend bool operator==(const MeshBodyScene&, const MeshBodyScene&) = default;
 };
 
+/// outputs.cor_table: a restitution table for DEM codes (app/cor_table.hpp) written with the run's
+/// other outputs -- `file` (CSV) and its JSON header (same stem, .json). Sphere impact scenes only.
+struct CorTableScene {
+  std::string file;              ///< plain file name ending in .csv
+  std::vector<double> speeds;    ///< empty: 9 speeds from u/10 to 10 u around the scene's speed u
+  std::size_t probabilities = 201;
+  std::uint64_t drops = 100000;  ///< per speed
+  std::vector<double> spins;     ///< incoming Omega_x grid [rad/s]; empty: the scene's Omega
+  std::size_t omega_bands = 0;   ///< Omega'_x per eps band (joint draws); 0: none
+
+  friend bool operator==(const CorTableScene&, const CorTableScene&) = default;
+};
+
+/// The JSON header's name of a restitution table file ("steel.csv" -> "steel.json").
+std::string cor_table_header_name(const std::string& csv);
+
 /// Largest exponent m of a superellipsoid body.smooth = [a, b, c, m] (|x/a|^m must stay finite).
 inline constexpr double kMaxSuperellipsoidExponent = 100;
 
@@ -74,6 +90,8 @@ struct Scene {
   /// Asperity radii "levels"/"lognormal"; on a sphere the run is run_radii_experiment.
   /// nullopt: every asperity has radius ensemble.sphere.asperity_radius (the paper).
   std::optional<RadiiScene> radii;
+  /// outputs.cor_table: also write a restitution table (sphere impact scenes); nullopt: none.
+  std::optional<CorTableScene> cor_table;
 };
 
 /// Names of the built-in presets (the files scenes/NAME.toml, embedded in the library).

@@ -126,58 +126,61 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
   return v;
 }
 
-}  // namespace
-
-Options parse_command_line(std::span<const std::string> args, const SceneLoader& load) {
-  CLI::App app{"validate-geometry: contact statistics of explicit rough spheres against the laws of "
-               "Gunkelmann, Montaine & Poeschel, PRE 89, 022205 (2014). Lengths in metres.",
-               "validate-geometry"};
+// The options as the user wrote them: every value is text until its own parser reads it, so that a
+// bad value is named as written.
+struct RawOptions {
   std::string preset_name = "fig3", asperities, radius, asperity_radius, drops, spheres, mode, backend, seed, out;
   std::string threads, alpha;
   bool no_plots = false, quiet = false;
   std::string scene_file;
-  auto* preset_opt = app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
-  app.add_option("--scene", scene_file, "scene file (TOML, see README \"Scenes\"); the options below override it")
+  std::string speed, omega_x, omega_y;
+  std::string variants, sequences;
+};
+
+void add_options(CLI::App& app, RawOptions& r) {
+  auto* preset_opt = app.add_option("--preset", r.preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
+  app.add_option("--scene", r.scene_file, "scene file (TOML, see README \"Scenes\"); the options below override it")
       ->excludes(preset_opt);
-  app.add_option("--asperities,-N", asperities, "number of asperities N (>= 1)");
-  app.add_option("--radius", radius, "central sphere radius R [m]");
-  app.add_option("--asperity-radius", asperity_radius, "asperity radius a [m], 0 < a < R");
-  app.add_option("--drops", drops, "number of drops (explicit: spheres x rotations)");
-  app.add_option("--mode", mode,
+  app.add_option("--asperities,-N", r.asperities, "number of asperities N (>= 1)");
+  app.add_option("--radius", r.radius, "central sphere radius R [m]");
+  app.add_option("--asperity-radius", r.asperity_radius, "asperity radius a [m], 0 < a < R");
+  app.add_option("--drops", r.drops, "number of drops (explicit: spheres x rotations)");
+  app.add_option("--mode", r.mode,
                  "explicit (default: K explicit spheres x M rotations, contacts by spatial query) or sampled (drawn "
                  "from the exact finite-N law of the lowest asperity; no geometry); fixed and fresh are read as explicit");
-  app.add_option("--spheres,-K", spheres, "number of explicit spheres K (explicit design; default: from the error budget)");
-  app.add_option("--seed", seed, "random seed (results are identical for any thread count)");
-  app.add_option("--backend", backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
-  app.add_option("--threads", threads, "OpenMP threads (0 = all)");
-  app.add_option("--alpha", alpha, "significance level of each test, in (0,1)");
-  app.add_option("--out", out, "output directory for report.json and figures");
-  std::string speed, omega_x, omega_y;
-  app.add_option("--speed", speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
-  app.add_option("--omega-x", omega_x, "impact: spin Omega_x before [rad/s]");
-  app.add_option("--omega-y", omega_y, "impact: spin Omega_y before [rad/s]");
-  std::string variants, sequences;
-  app.add_option("--variant", variants, "bounce runs (fig6): comma list of paper, paper-printed33, paper-corrected28, random-orientation, dynamic");
-  app.add_option("--sequences", sequences, "bounce runs (fig6): bounce sequences per variant");
-  app.add_flag("--no-plots", no_plots, "do not write PNG figures");
-  app.add_flag("--quiet,-q", quiet, "print no progress");
+  app.add_option("--spheres,-K", r.spheres, "number of explicit spheres K (explicit design; default: from the error budget)");
+  app.add_option("--seed", r.seed, "random seed (results are identical for any thread count)");
+  app.add_option("--backend", r.backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
+  app.add_option("--threads", r.threads, "OpenMP threads (0 = all)");
+  app.add_option("--alpha", r.alpha, "significance level of each test, in (0,1)");
+  app.add_option("--out", r.out, "output directory for report.json and figures");
+  app.add_option("--speed", r.speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
+  app.add_option("--omega-x", r.omega_x, "impact: spin Omega_x before [rad/s]");
+  app.add_option("--omega-y", r.omega_y, "impact: spin Omega_y before [rad/s]");
+  app.add_option("--variant", r.variants, "bounce runs (fig6): comma list of paper, paper-printed33, paper-corrected28, random-orientation, dynamic");
+  app.add_option("--sequences", r.sequences, "bounce runs (fig6): bounce sequences per variant");
+  app.add_flag("--no-plots", r.no_plots, "do not write PNG figures");
+  app.add_flag("--quiet,-q", r.quiet, "print no progress");
+}
 
-  Options o;
-  // "--out=" (nothing after '='): CLI11 would take the next argument as the value.
+// "--out=" (nothing after '='): CLI11 would take the next argument as the value.
+void refuse_empty_equals(std::span<const std::string> args) {
   for (const auto& a : args) {
     if (a == "--") break;
     if (a.size() > 3 && a.compare(0, 2, "--") == 0 && a.back() == '=' && a.find('=') == a.size() - 1)
       throw BadInput(a.substr(0, a.size() - 1) + ": '' (an empty value after '=') is not a value; write " +
                      a.substr(0, a.size() - 1) + "=VALUE or " + a.substr(0, a.size() - 1) + " VALUE");
   }
+}
+
+// CLI11's parse; false when --help was asked for. Unknown arguments are BadInput.
+bool parse_arguments(CLI::App& app, std::span<const std::string> args) {
   app.allow_extras();
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 consumes from the back
     app.parse(reversed);
   } catch (const CLI::CallForHelp&) {
-    o.help = true;
-    o.help_text = app.help();
-    return o;
+    return false;
   } catch (const CLI::ParseError& e) {
     throw BadInput(std::string(e.what()) + "\nRun with --help for more information.");
   }
@@ -187,138 +190,215 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
     for (const auto& x : extra) list += " " + x;
     throw BadInput("The following arguments were not expected:" + list + "\nRun with --help for more information.");
   }
+  return true;
+}
 
+// Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
+struct Given {
+  const CLI::App& app;
+  bool operator()(const char* name) const { return app.count(name) > 0; }
+};
+
+// An option that cannot apply to the scene's kind of run is an error naming it and why, never
+// silently ignored.
+[[noreturn]] void refuse(const std::string& option, const std::string& why) { throw BadInput(option + ": " + why); }
+
+// The kind of run a scene is, for the options that apply to some kinds only.
+struct RunKind {
+  bool bounce = false, mesh = false, radii = false;
+  std::string text;  ///< named in refusals
+};
+
+RunKind run_kind(const Scene& scene) {
+  RunKind k;
+  k.bounce = scene.bounce.enabled, k.mesh = scene.mesh.has_value(), k.radii = scene.radii && !scene.mesh;
+  k.text = k.bounce ? "a bounce run (experiment.kind = \"bounce\")"
+           : k.mesh ? "a mesh body (body.kind = \"mesh\")"
+                    : "a run with unequal asperity radii on a sphere (asperities.radius \"" +
+                          std::string(k.radii && scene.radii->radii.kind == RadiusDistribution::Kind::lognormal
+                                          ? "lognormal"
+                                          : "levels") +
+                          "\")";
+  return k;
+}
+
+// --asperities, --radius, --asperity-radius.
+void apply_body_options(Scene& scene, const RawOptions& r, const Given& given) {
+  auto& e = scene.ensemble;
+  if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", r.asperities, 1, kMaxAsperities);
+  if (given("--radius")) {
+    const double radius = parse_positive("--radius", r.radius);
+    if (scene.mesh)
+      refuse("--radius", "a mesh body's size is its mesh file x body.scale (body.kind = \"mesh\"); --radius is the "
+                         "radius of a sphere body");
+    e.sphere.radius = radius;
+  }
+  if (given("--asperity-radius")) {
+    // Every asperity gets this radius: the option replaces a "levels"/"lognormal" distribution of
+    // the file by "fixed" (on a sphere the run becomes the paper's; a mesh stays a mesh run).
+    e.sphere.asperity_radius = parse_positive("--asperity-radius", r.asperity_radius);
+    scene.radii.reset();
+  }
+}
+
+void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+  auto& e = scene.ensemble;
+  const std::string& mode = r.mode;
+  e.mode = parse_mode(mode);
+  // Earlier names: "fixed" = explicit; "fresh" = explicit (with a note), for unequal radii their sampler.
+  scene.legacy_mode = is_legacy_mode(mode) && !k.radii && !k.mesh && !k.bounce ? mode : std::string();
+  if (k.radii && mode == "fresh") e.mode = Mode::sampled;
+  // A backend the file chose for its explicit spheres does not apply to sampled drops.
+  if (e.mode == Mode::sampled && !given("--backend")) scene.backend_auto = true;
+  if (k.bounce) refuse("--mode", "not used by " + k.text + ": every sequence bounces its own sphere");
+  if (k.mesh && e.mode != Mode::explicit_spheres)
+    refuse("--mode", "'" + mode + "': " + k.text + " runs explicit bodies x rotations: only \"explicit\"");
+  if (k.radii && e.mode != Mode::sampled)
+    refuse("--mode", "'" + mode + "': " + k.text + " draws from its exact sampler and screens [screening] bodies: only "
+                     "\"sampled\" (or give --asperity-radius for the paper's equal radii)");
+}
+
+// --drops, --mode, --spheres, --seed: the design of the ensemble.
+void apply_design_options(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+  auto& e = scene.ensemble;
+  if (given("--drops")) {
+    e.drops = parse_count("--drops", r.drops, 1, kMaxDrops);
+    if (k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
+  }
+  if (given("--mode")) apply_mode_option(scene, r, given, k);
+  if (given("--spheres")) {
+    e.spheres = parse_count("--spheres", r.spheres, 1, kMaxDrops);
+    scene.spheres_auto = false;
+    if ((k.bounce && !k.mesh) || k.radii)
+      refuse("--spheres", "not used by " + k.text + (k.radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
+    if (!k.mesh && e.mode != Mode::explicit_spheres)
+      refuse("--spheres", "only for the explicit design (explicit spheres x rotations); sampled drops build no sphere: "
+                          "add --mode explicit");
+  }
+  if (given("--seed")) e.seed = parse_count("--seed", r.seed, 0, ~std::uint64_t{0});
+}
+
+// --speed, --omega-x, --omega-y: the impact (a mesh body's bounce takes the spin as its start).
+void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+  auto& e = scene.ensemble;
+  if (given("--speed")) {
+    const double u = parse_positive("--speed", r.speed, "m/s");
+    if (k.radii) refuse("--speed", k.text + " is analysed as contacts only (no impacts)");
+    e.impact.enabled = true;
+    scene.restitution_stats = true;
+    e.impact.speed = u;
+  }
+  if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", r.omega_x);
+  if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", r.omega_y);
+  if (!given("--omega-x") && !given("--omega-y")) return;
+  const std::string opt = given("--omega-x") ? "--omega-x" : "--omega-y";
+  if (k.bounce && k.mesh) {  // a mesh body's bounce starts with experiment.Omega
+    if (given("--omega-x")) scene.bounce.omega.x() = e.impact.omega.x();
+    if (given("--omega-y")) scene.bounce.omega.y() = e.impact.omega.y();
+  } else if (k.bounce) {
+    refuse(opt, "not used by " + k.text + ": every sequence starts without spin (Omega = 0, Sec. V)");
+  }
+  if (k.radii) refuse(opt, k.text + " is analysed as contacts only (no impacts)");
+  if (!e.impact.enabled && !(k.bounce && k.mesh))
+    refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
+}
+
+void apply_backend_option(Scene& scene, const RawOptions& r, const RunKind& k) {
+  auto& e = scene.ensemble;
+  e.backend = parse_backend(r.backend);
+  scene.backend_auto = false;
+  if (k.bounce || k.mesh || k.radii)
+    refuse("--backend", "not used by " + k.text + (k.bounce ? "" : ", which queries the exact support tree"));
+  if (e.mode != Mode::explicit_spheres)
+    refuse("--backend", "only for the explicit design (explicit spheres); sampled drops query no index (the lowest "
+                        "asperities are drawn from the exact law): add --mode explicit");
+}
+
+// --variant "paper,dynamic,...": each variant once (parse_bounce_variant names an unknown one).
+std::vector<BounceVariant> parse_variants(const std::string& variants) {
+  std::vector<BounceVariant> out;
+  std::size_t pos = 0;
+  do {
+    const std::size_t comma = variants.find(',', pos);
+    const BounceVariant v = parse_bounce_variant(variants.substr(pos, comma - pos));
+    if (std::find(out.begin(), out.end(), v) != out.end())
+      throw BadInput("--variant: '" + std::string(to_string(v)) + "' is given twice in '" + variants +
+                     "' (a variant compared with itself decides nothing)");
+    out.push_back(v);
+    pos = comma == std::string::npos ? comma : comma + 1;
+  } while (pos != std::string::npos);
+  return out;
+}
+
+// --variant, --sequences, and --speed as the bounce's first speed.
+void apply_bounce_options(Scene& scene, const RawOptions& r, const Given& given) {
+  if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
+    throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
+  if (!scene.bounce.enabled) return;
+  auto& e = scene.ensemble;
+  if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
+  if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", r.sequences, 1, kMaxDrops);
+  if (given("--variant")) scene.bounce.variants = parse_variants(r.variants);
+}
+
+// --threads, --alpha, --no-plots, --out; and the scene's name says when options changed the physics.
+void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
+  if (given("--threads")) {
+    const std::uint64_t t = parse_count("--threads", r.threads, 0, std::uint64_t(kMaxThreads));
+    scene.ensemble.threads = static_cast<int>(t);
+  }
+  if (given("--alpha")) {
+    const double a = parse_real("--alpha", r.alpha);
+    if (!(a > 0 && a < 1)) throw BadInput("--alpha: '" + r.alpha + "' must be in (0, 1)");
+    if (scene.bounce.enabled)
+      throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
+                     "decide nothing (exit status 0)");
+    scene.alpha = a;
+  }
+  if (r.no_plots) scene.plots = false;
+  if (given("--out")) {
+    if (r.out.empty()) throw BadInput("--out: '' is not a directory name");
+    scene.out = r.out;
+  }
+  if (!given("--scene") && r.preset_name != scene.name) scene.name = r.preset_name;
+  if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
+      given("--speed") || given("--omega-x") || given("--omega-y"))
+    scene.name += "+custom";
+}
+
+// The preset or scene file, then the options over it (README "Scenes"), in this order: the kind of
+// run is taken after --asperity-radius, which can turn a radii run into the paper's.
+Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoader& load) {
+  Scene scene = !given("--scene") ? preset(r.preset_name) : load ? load(r.scene_file) : load_scene(r.scene_file);
+  apply_body_options(scene, r, given);
+  const RunKind k = run_kind(scene);
+  apply_design_options(scene, r, given, k);
+  apply_impact_options(scene, r, given, k);
+  if (given("--backend")) apply_backend_option(scene, r, k);
+  apply_bounce_options(scene, r, given);
+  apply_run_options(scene, r, given);
+  validate(scene);
+  return scene;
+}
+
+}  // namespace
+
+Options parse_command_line(std::span<const std::string> args, const SceneLoader& load) {
+  CLI::App app{"validate-geometry: contact statistics of explicit rough spheres against the laws of "
+               "Gunkelmann, Montaine & Poeschel, PRE 89, 022205 (2014). Lengths in metres.",
+               "validate-geometry"};
+  RawOptions raw;
+  add_options(app, raw);
+  Options o;
+  refuse_empty_equals(args);
+  if (!parse_arguments(app, args)) {
+    o.help = true;
+    o.help_text = app.help();
+    return o;
+  }
   try {
-    // Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
-    auto given = [&](const char* name) { return app.count(name) > 0; };
-    Scene scene = !given("--scene") ? preset(preset_name) : load ? load(scene_file) : load_scene(scene_file);
-    auto& e = scene.ensemble;
-    // Options override the file (README "Scenes"). An option that cannot apply to the scene's
-    // kind of run is an error naming it and why, never silently ignored.
-    auto refuse = [](const std::string& option, const std::string& why) { throw BadInput(option + ": " + why); };
-    if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", asperities, 1, kMaxAsperities);
-    if (given("--radius")) {
-      const double r = parse_positive("--radius", radius);
-      if (scene.mesh)
-        refuse("--radius", "a mesh body's size is its mesh file x body.scale (body.kind = \"mesh\"); --radius is the "
-                           "radius of a sphere body");
-      e.sphere.radius = r;
-    }
-    if (given("--asperity-radius")) {
-      // Every asperity gets this radius: the option replaces a "levels"/"lognormal" distribution of
-      // the file by "fixed" (on a sphere the run becomes the paper's; a mesh stays a mesh run).
-      e.sphere.asperity_radius = parse_positive("--asperity-radius", asperity_radius);
-      scene.radii.reset();
-    }
-    const bool bounce = scene.bounce.enabled, mesh = scene.mesh.has_value(), radii = scene.radii && !scene.mesh;
-    const std::string kind = bounce ? "a bounce run (experiment.kind = \"bounce\")"
-                             : mesh ? "a mesh body (body.kind = \"mesh\")"
-                                    : "a run with unequal asperity radii on a sphere (asperities.radius \"" +
-                                          std::string(radii && scene.radii->radii.kind == RadiusDistribution::Kind::lognormal
-                                                          ? "lognormal"
-                                                          : "levels") +
-                                          "\")";
-    if (given("--drops")) {
-      e.drops = parse_count("--drops", drops, 1, kMaxDrops);
-      if (bounce) refuse("--drops", "not used by " + kind + ", which counts bounce sequences: use --sequences");
-    }
-    if (given("--mode")) {
-      e.mode = parse_mode(mode);
-      // Earlier names: "fixed" = explicit; "fresh" = explicit (with a note), for unequal radii their sampler.
-      scene.legacy_mode = is_legacy_mode(mode) && !radii && !mesh && !bounce ? mode : std::string();
-      if (radii && mode == "fresh") e.mode = Mode::sampled;
-      // A backend the file chose for its explicit spheres does not apply to sampled drops.
-      if (e.mode == Mode::sampled && !given("--backend")) scene.backend_auto = true;
-      if (bounce) refuse("--mode", "not used by " + kind + ": every sequence bounces its own sphere");
-      if (mesh && e.mode != Mode::explicit_spheres)
-        refuse("--mode", "'" + mode + "': " + kind + " runs explicit bodies x rotations: only \"explicit\"");
-      if (radii && e.mode != Mode::sampled)
-        refuse("--mode", "'" + mode + "': " + kind + " draws from its exact sampler and screens [screening] bodies: only "
-                         "\"sampled\" (or give --asperity-radius for the paper's equal radii)");
-    }
-    if (given("--spheres")) {
-      e.spheres = parse_count("--spheres", spheres, 1, kMaxDrops);
-      scene.spheres_auto = false;
-      if ((bounce && !mesh) || radii)
-        refuse("--spheres", "not used by " + kind + (radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
-      if (!mesh && e.mode != Mode::explicit_spheres)
-        refuse("--spheres", "only for the explicit design (explicit spheres x rotations); sampled drops build no sphere: "
-                            "add --mode explicit");
-    }
-    if (given("--seed")) e.seed = parse_count("--seed", seed, 0, ~std::uint64_t{0});
-    if (given("--speed")) {
-      const double u = parse_positive("--speed", speed, "m/s");
-      if (radii) refuse("--speed", kind + " is analysed as contacts only (no impacts)");
-      e.impact.enabled = true;
-      scene.restitution_stats = true;
-      e.impact.speed = u;
-    }
-    if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", omega_x);
-    if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", omega_y);
-    if (given("--omega-x") || given("--omega-y")) {
-      const std::string opt = given("--omega-x") ? "--omega-x" : "--omega-y";
-      if (bounce && mesh) {  // a mesh body's bounce starts with experiment.Omega
-        if (given("--omega-x")) scene.bounce.omega.x() = e.impact.omega.x();
-        if (given("--omega-y")) scene.bounce.omega.y() = e.impact.omega.y();
-      } else if (bounce) {
-        refuse(opt, "not used by " + kind + ": every sequence starts without spin (Omega = 0, Sec. V)");
-      }
-      if (radii) refuse(opt, kind + " is analysed as contacts only (no impacts)");
-      if (!e.impact.enabled && !(bounce && mesh))
-        refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
-    }
-    if (given("--backend")) {
-      e.backend = parse_backend(backend);
-      scene.backend_auto = false;
-      if (bounce || mesh || radii)
-        refuse("--backend", "not used by " + kind + (bounce ? "" : ", which queries the exact support tree"));
-      if (e.mode != Mode::explicit_spheres)
-        refuse("--backend", "only for the explicit design (explicit spheres); sampled drops query no index (the lowest "
-                            "asperities are drawn from the exact law): add --mode explicit");
-    }
-    if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
-      throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
-    if (scene.bounce.enabled) {
-      if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
-      if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", sequences, 1, kMaxDrops);
-      if (given("--variant")) {
-        scene.bounce.variants.clear();
-        std::size_t pos = 0;
-        do {
-          const std::size_t comma = variants.find(',', pos);
-          const BounceVariant v = parse_bounce_variant(variants.substr(pos, comma - pos));
-          if (std::find(scene.bounce.variants.begin(), scene.bounce.variants.end(), v) != scene.bounce.variants.end())
-            throw BadInput("--variant: '" + std::string(to_string(v)) + "' is given twice in '" + variants +
-                           "' (a variant compared with itself decides nothing)");
-          scene.bounce.variants.push_back(v);
-          pos = comma == std::string::npos ? comma : comma + 1;
-        } while (pos != std::string::npos);
-      }
-    }
-    if (given("--threads")) {
-      const std::uint64_t t = parse_count("--threads", threads, 0, std::uint64_t(kMaxThreads));
-      e.threads = static_cast<int>(t);
-    }
-    if (given("--alpha")) {
-      const double a = parse_real("--alpha", alpha);
-      if (!(a > 0 && a < 1)) throw BadInput("--alpha: '" + alpha + "' must be in (0, 1)");
-      if (scene.bounce.enabled)
-        throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
-                       "decide nothing (exit status 0)");
-      scene.alpha = a;
-    }
-    if (no_plots) scene.plots = false;
-    if (given("--out")) {
-      if (out.empty()) throw BadInput("--out: '' is not a directory name");
-      scene.out = out;
-    }
-    if (!given("--scene") && preset_name != scene.name) scene.name = preset_name;
-    if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
-        given("--speed") || given("--omega-x") || given("--omega-y"))
-      scene.name += "+custom";
-    validate(scene);
-    o.scene = std::move(scene);
-    o.quiet = quiet;
+    o.scene = scene_with_options(raw, Given{app}, load);
+    o.quiet = raw.quiet;
     return o;
   } catch (const BadInput&) {
     throw;
