@@ -184,11 +184,15 @@ SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* l
   auto t0 = Clock::now();
   auto bounce = s.bounce;
   bounce.alpha = s.alpha;  // the verdicts of the Eq. 2 bootstrap use the scene's level
+  bounce.tangential = e.impact.tangential;
   const auto reports = run_bounce_experiment(e.sphere, bounce, e.seed, e.threads, log, progress);
   const double seconds_bounce = since(t0);
   t0 = Clock::now();
   const auto comparisons = compare_bounce_variants(reports);
   std::ostringstream table;
+  TangentialLaw law = bounce.tangential;
+  if (law.model == TangentialLaw::Model::kinematic) law.eps_t = bounce.eps_t;
+  table << "tangential law of the explicit variants: " << law.describe() << "\n";
   table << format_bounce_table(reports);
   for (const auto& c : comparisons)
     table << "KS " << to_string(c.a) << " vs " << to_string(c.b) << ", " << c.by << " [" << c.lo << ", " << c.hi
@@ -204,7 +208,7 @@ SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* l
       header_of(s, {stage("bounce", true, "bounce sequences per variant, fits and bootstrap goodness of fit", seconds_bounce),
                     stage("analysis", true, "two-sample KS between variants", seconds_analysis),
                     plots_stage(s, seconds_plots)});
-  o.json = with_header(bounce_to_json(s.name, e.sphere, s.bounce, e.seed, reports, plots, comparisons), h);
+  o.json = with_header(bounce_to_json(s.name, e.sphere, bounce, e.seed, reports, plots, comparisons), h);
   return o;
 }
 

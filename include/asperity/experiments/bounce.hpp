@@ -68,6 +68,11 @@ struct BounceExperiment {
   double density = 7850;     ///< [kg/m^3] (eps does not depend on it)
   double beta = 0.0467;      ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
   double eps_t = 1.0;        ///< tangential restitution (paper: 1)
+  /// The tangential law of the explicit variants (core/tangential.hpp): kinematic (the default)
+  /// uses eps_t above; coulomb, stronge and walton solve each impact with solve_impact. The paper
+  /// variants are the paper's kinematic law and refuse anything else (run_bounces). Mesh-body
+  /// bounces take their law from MeshBounceOptions::tangential instead.
+  TangentialLaw tangential;
   unsigned max_impacts = 100000;  ///< safety bound per sequence
   std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
                                   ///< max(19, 2e7/n): the work is B n; the count used is reported)
