@@ -154,7 +154,11 @@ TEST(TangentialRuns, RoughSphereImpactsAndBouncesTakeTheLaw) {
   for (std::size_t j = 0; j < k0.eps.size(); ++j)
     (k0.number[j] == 1 ? first : later) = std::max(k0.number[j] == 1 ? first : later, std::abs(k0.eps[j] - s0.eps[j]));
   EXPECT_LT(first, 1e-12);
+  // Later impacts: the contact point's slip stays ~|Omega| x (the change of the few-micrometre
+  // contact offset), which any law leaves small: |d eps| <= 4.0e-8 measured, 1e-3 of the roughness
+  // scatter (~5e-5 at N = 1e5); the bound 1e-6 still fails a law that lost the sticking.
   EXPECT_GT(later, first);
+  EXPECT_LT(later, 1e-6);
   EXPECT_THROW(run_bounces(sphere, b, BounceVariant::paper, 3), std::invalid_argument);
 }
 
