@@ -191,6 +191,11 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
                  {"density_kg_m3", b.density},
                  {"beta", b.beta},
                  {"eps_t", b.eps_t},
+                 {"tangential", [&] {
+                    TangentialLaw law = b.tangential;
+                    if (law.model == TangentialLaw::Model::kinematic) law.eps_t = b.eps_t;
+                    return law.describe();
+                  }()},
                  {"bootstrap", b.bootstrap},
                  {"alpha", b.alpha},
                  {"eps_time_note", "eps(times) = T_k / T_(k-1) from the flight times before and after impact k; it differs "
@@ -345,6 +350,7 @@ std::string to_json(const MeshBounceReport& r) {
   TangentialLaw law = e.options.tangential;
   if (law.model == TangentialLaw::Model::kinematic) law.eps_t = e.options.bounce.eps_t;
   j["tangential"] = law.describe();
+  j["bounce"]["tangential"] = law.describe();  // the body's law, not the sphere variants' default
   j["parameters"] = {{"asperities", e.asperities}, {"radii", e.radii.describe()}, {"bodies", e.bodies}, {"seed", e.seed}};
   j["body"] = {{"name", r.body_name},
                {"mesh", e.mesh.string()},

@@ -546,8 +546,10 @@ std::string format_table(const GeometryReport& r) {
      << ")\n";
   if (r.scene.ensemble.impact.enabled) {
     const auto& x = r.scene.ensemble.impact;
-    os << "impact: u = " << x.speed << " m/s, Omega = (" << x.omega.x() << ", " << x.omega.y() << ", " << x.omega.z()
-       << ") rad/s, eps_t = " << x.eps_t << ", Pade [1/4] beta = " << x.beta << "; mean eps_n = " << fmt(r.eps_n_mean, 8)
+    os << "impact: u = " << x.speed << " m/s, Omega = (" << x.omega.x() << ", " << x.omega.y() << ", " << x.omega.z() << ") rad/s, ";
+    if (x.tangential.model == TangentialLaw::Model::kinematic) os << "eps_t = " << x.eps_t;
+    else os << "tangential law " << x.tangential.describe();
+    os << ", Pade [1/4] beta = " << x.beta << "; mean eps_n = " << fmt(r.eps_n_mean, 8)
        << ", deficit eps_n - <eps> = " << fmt(r.eps_deficit.value, 4) << " +- " << fmt(r.eps_deficit.se, 2)
        << "; drops without impact: " << r.no_impacts << "\n";
   }
@@ -583,8 +585,15 @@ nlohmann::json impact_json(const ImpactExperiment& x) {
           {"density_kg_m3", x.density},
           {"beta", x.beta},
           {"eps_t", x.eps_t},
+          {"tangential", [&] {
+             TangentialLaw law = x.tangential;
+             if (law.model == TangentialLaw::Model::kinematic) law.eps_t = x.eps_t;
+             return law.describe();
+           }()},
           {"restitution_model", "viscoelastic-pade14"},
-          {"solver", "closed form (Sherman-Morrison), tested against the general 3x3 solve"}};
+          {"solver", x.tangential.model == TangentialLaw::Model::kinematic
+                         ? "closed form (Sherman-Morrison), tested against the general 3x3 solve"
+                         : "impulse process of the tangential law (core/tangential.hpp solve_impact)"}};
 }
 
 nlohmann::json design_json(const GeometryReport& r) {

@@ -206,17 +206,21 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress, const std::filesy
   return o;
 }
 
-SceneOutput run_bounce(const Scene& s, std::ostream* log, const std::filesystem::path& dir) {
+SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* log, const std::filesystem::path& dir) {
   const auto& e = s.ensemble;
   SceneOutput o;
   auto t0 = Clock::now();
   auto bounce = s.bounce;
   bounce.alpha = s.alpha;  // the verdicts of the Eq. 2 bootstrap use the scene's level
-  const auto reports = run_bounce_experiment(e.sphere, bounce, e.seed, e.threads, log);
+  bounce.tangential = e.impact.tangential;
+  const auto reports = run_bounce_experiment(e.sphere, bounce, e.seed, e.threads, log, progress);
   const double seconds_bounce = since(t0);
   t0 = Clock::now();
   const auto comparisons = compare_bounce_variants(reports);
   std::ostringstream table;
+  TangentialLaw law = bounce.tangential;
+  if (law.model == TangentialLaw::Model::kinematic) law.eps_t = bounce.eps_t;
+  table << "tangential law of the explicit variants: " << law.describe() << "\n";
   table << format_bounce_table(reports);
   for (const auto& c : comparisons)
     table << "KS " << to_string(c.a) << " vs " << to_string(c.b) << ", " << c.by << " [" << c.lo << ", " << c.hi
@@ -232,7 +236,7 @@ SceneOutput run_bounce(const Scene& s, std::ostream* log, const std::filesystem:
       header_of(s, {stage("bounce", true, "bounce sequences per variant, fits and bootstrap goodness of fit", seconds_bounce),
                     stage("analysis", true, "two-sample KS between variants", seconds_analysis),
                     plots_stage(s, seconds_plots)});
-  o.json = with_header(bounce_to_json(s.name, e.sphere, s.bounce, e.seed, reports, plots, comparisons), h);
+  o.json = with_header(bounce_to_json(s.name, e.sphere, bounce, e.seed, reports, plots, comparisons), h);
   return o;
 }
 
@@ -465,7 +469,7 @@ SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostr
     case RunKind::sphere: o = run_sphere(s, progress, into); break;
     case RunKind::radii: o = run_radii(s, progress, into); break;
     case RunKind::mesh: o = run_mesh(s, progress, into); break;
-    case RunKind::bounce: o = run_bounce(s, log, into); break;
+    case RunKind::bounce: o = run_bounce(s, progress, log, into); break;
     case RunKind::mesh_bounce: o = run_mesh_bounce(s, progress, into); break;
   }
   o.kind = run_kind(s);

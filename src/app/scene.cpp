@@ -121,6 +121,19 @@ void validate_bounce(const Scene& s) {
           throw std::invalid_argument("experiment.variants: \"" + std::string(to_string(s.bounce.variants[i])) +
                                       "\" is given twice (a variant compared with itself decides nothing)");
   }
+  // A tangential law other than the kinematic one acts in solved impacts: mesh bodies, sphere
+  // impacts and the sphere's explicit bounce variants; the paper's procedure is its kinematic law.
+  if (const auto& law = s.ensemble.impact.tangential; law.model != TangentialLaw::Model::kinematic) {
+    if (!s.mesh && !s.ensemble.impact.enabled && !s.bounce.enabled)
+      throw std::invalid_argument("material.tangential.model: " + law.describe() +
+                                  " needs impacts (an impact or bounce experiment); this run only finds contacts");
+    if (s.bounce.enabled && !s.mesh)
+      for (auto v : s.bounce.variants)
+        if (v != BounceVariant::random_orientation && v != BounceVariant::dynamic)
+          throw std::invalid_argument("material.tangential.model: " + law.describe() +
+                                      " applies to the explicit variants (random-orientation, dynamic); experiment.variants has \"" +
+                                      std::string(to_string(v)) + "\", the paper's procedure with its kinematic law");
+  }
   if (s.bounce.enabled && !s.mesh && s.bounce.omega != Vec3::Zero())
     throw std::invalid_argument("bounce: Omega is for mesh bodies; the sphere's variants start without spin (Sec. V)");
 }

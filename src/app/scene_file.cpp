@@ -402,9 +402,6 @@ void read_material(Reader& top, Scene& s) {
     impact.tangential = read_tangential(*tan);
     if (impact.tangential.model != TangentialLaw::Model::kinematic) {
       if (eps_t_given) mat->bad("eps_t", "belongs to the kinematic law; material.tangential chose " + impact.tangential.describe());
-      if (!s.mesh)
-        tan->bad("model", "laws other than \"kinematic\" apply to mesh bodies (body.kind = \"mesh\") in this release, got \"" +
-                          std::string(to_string(impact.tangential.model)) + "\"");
     } else if (eps_t_given) {
       mat->bad("eps_t", "give it once: tangential = { model = \"kinematic\", eps_t = ... } or eps_t, not both");
     } else {

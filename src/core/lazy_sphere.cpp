@@ -58,7 +58,9 @@ void LazySphere::reset(std::uint64_t seed, std::uint64_t sphere_id) {
   seed_ = seed, sphere_ = sphere_id;
   nodes_.clear();
   points_.clear();
-  nodes_.push_back(Node{-1.0, 1.0, 0.0, 2.0 * std::numbers::pi, 1, n_, 0});
+  const double two_pi = 2.0 * std::numbers::pi;
+  nodes_.push_back(Node{-1.0, 1.0, 0.0, two_pi, std::acos(-1.0), std::acos(1.0), 1.0, 0.0, std::cos(two_pi), std::sin(two_pi),
+                        1, n_, 0});
 }
 
 void LazySphere::expand(std::size_t i) {
@@ -66,16 +68,18 @@ void LazySphere::expand(std::size_t i) {
   Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id);
   const std::uint64_t left = binomial_half(c.count, s);
   // Split the longer side (arc lengths) at its equal-area midpoint.
-  const double dtheta = std::acos(std::clamp(c.z0, -1.0, 1.0)) - std::acos(std::clamp(c.z1, -1.0, 1.0));
+  const double dtheta = c.t0 - c.t1;  // acos(z0) - acos(z1)
   const double smax = std::max(std::sqrt((1 - c.z0) * (1 + c.z0)), std::sqrt((1 - c.z1) * (1 + c.z1)));
   const double width = (c.p1 - c.p0) * ((c.z0 <= 0 && c.z1 >= 0) ? 1.0 : smax);  // along the widest circle
   Node a = c, b = c;
   if (width > dtheta) {
     const double pm = 0.5 * (c.p0 + c.p1);
     a.p1 = pm, b.p0 = pm;
+    a.c1 = b.c0 = std::cos(pm), a.s1 = b.s0 = std::sin(pm);
   } else {
     const double zm = 0.5 * (c.z0 + c.z1);
     a.z1 = zm, b.z0 = zm;
+    a.t1 = b.t0 = std::acos(std::clamp(zm, -1.0, 1.0));
   }
   a.id = 2 * c.id, b.id = 2 * c.id + 1;
   a.count = left, b.count = c.count - left;
@@ -98,22 +102,29 @@ void LazySphere::fill(std::size_t i) {
   }
 }
 
-double LazySphere::lower_key(const Node& c, const Vec3& d, double dxy, double psi) {
+double LazySphere::lower_key(const Node& c, const Direction& q) {
   // max over the cell of u.d = s(z) dxy cos(phi - psi) + z dz, s = sqrt(1 - z^2) >= 0.
+  // psi in [-pi, pi], p0 in [0, 2 pi): psi - p0 > -3 pi, so two shifts by 2 pi bring it to [0, 2 pi)
+  // (rounding near the cell's edge only swaps cmax = 1 for a cosine within 1e-16 of it, inside
+  // the margin, as are the products of cached cosines and sines).
   constexpr double two_pi = 2.0 * std::numbers::pi;
   double cmax;
   const double span = c.p1 - c.p0;
-  double delta = std::fmod(psi - c.p0, two_pi);
+  double delta = q.psi - c.p0;
+  if (delta < 0) delta += two_pi;
   if (delta < 0) delta += two_pi;
   if (delta <= span) cmax = 1.0;
-  else cmax = std::max(std::cos(c.p0 - psi), std::cos(c.p1 - psi));
-  const double A = dxy * cmax, dz = d.z();
+  else cmax = std::max(c.c0 * q.cpsi + c.s0 * q.spsi, c.c1 * q.cpsi + c.s1 * q.spsi);  // cos(p - psi)
+  const double A = q.dxy * cmax, dz = q.d.z();
   auto f = [&](double z) { return A * std::sqrt(std::max(0.0, (1 - z) * (1 + z))) + dz * z; };
   double ub;
   if (A > 0) {
-    const double zs = dz / std::hypot(A, dz);  // unconstrained maximum of the concave f
-    ub = f(std::clamp(zs, c.z0, c.z1));
-    if (zs >= c.z0 && zs <= c.z1) ub = std::max(ub, std::hypot(A, dz));
+    // |(A, dz)| <= 1: no overflow, so sqrt instead of the much slower std::hypot (its last-ulp
+    // accuracy is far inside the 1e-13 margin).
+    // The concave f peaks at zs = dz / norm with f(zs) = norm; compared as dz against z norm (no
+    // division), the peak inside the cell bounds it by norm itself, else the nearer end does.
+    const double norm = std::sqrt(A * A + dz * dz);
+    ub = dz < c.z0 * norm ? f(c.z0) : dz > c.z1 * norm ? f(c.z1) : norm;
   } else {
     ub = std::max(f(c.z0), f(c.z1));  // convex: maximum at an end
   }
@@ -121,13 +132,16 @@ double LazySphere::lower_key(const Node& c, const Vec3& d, double dxy, double ps
 }
 
 LazyNearest LazySphere::lowest(const Vec3& d) {
-  const double dxy = std::hypot(d.x(), d.y());
-  const double psi = std::atan2(d.y(), d.x());
+  Direction q;
+  q.d = d;
+  q.dxy = std::hypot(d.x(), d.y());
+  q.psi = std::atan2(d.y(), d.x());
+  q.cpsi = q.dxy > 0 ? d.x() / q.dxy : 1.0, q.spsi = q.dxy > 0 ? d.y() / q.dxy : 0.0;
   detail::TopTwo top;
   auto& h = heap_;
   h.clear();
   auto cmp = std::greater<std::pair<double, std::size_t>>();
-  h.emplace_back(lower_key(nodes_[0], d, dxy, psi), 0);
+  h.emplace_back(lower_key(nodes_[0], q), 0);
   while (!h.empty()) {
     std::pop_heap(h.begin(), h.end(), cmp);
     const auto [lb, i] = h.back();
@@ -144,7 +158,7 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
     const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
     for (std::size_t k = ch; k < ch + 2; ++k) {
       if (nodes_[k].count == 0) continue;
-      const double lk = lower_key(nodes_[k], d, dxy, psi);
+      const double lk = lower_key(nodes_[k], q);
       if (lk > top.second_key()) continue;
       h.emplace_back(lk, k);
       std::push_heap(h.begin(), h.end(), cmp);

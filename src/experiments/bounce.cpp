@@ -19,6 +19,7 @@
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
 #include "asperity/core/restitution.hpp"
+#include "asperity/core/tangential.hpp"
 #include "asperity/laws/theory_impact.hpp"
 #include "core/format.hpp"
 
@@ -62,6 +63,7 @@ void validate(const BounceExperiment& b) {
   pos("density", b.density);
   pos("beta", b.beta);
   if (!std::isfinite(b.eps_t) || b.eps_t < -1 || b.eps_t > 1) throw std::invalid_argument("bounce: eps_t must be in [-1, 1], got " + num(b.eps_t));
+  validate(b.tangential);
   if (b.max_impacts < 1) throw std::invalid_argument("bounce: max_impacts must be >= 1");
   for (const auto& [lo, hi] : b.windows)
     if (!std::isfinite(lo) || !std::isfinite(hi) || !(lo >= 0) || !(lo < hi))
@@ -99,7 +101,18 @@ struct Physics {
   double R, a, mass, J, g;
   const Restitution* eps_n;
   double beta;
+  TangentialLaw law;  // kinematic: the closed form with b.eps_t; else the impulse process
 };
+
+// The impact of the explicit variants: the paper's kinematic law in closed form (as before, bit for
+// bit), any other tangential law by core/tangential's solve_impact on the same sphere.
+std::optional<ImpactResult> sphere_impact(const Physics& p, const ImpactState& st, double e, double eps_t) {
+  if (p.law.model == TangentialLaw::Model::kinematic) return solve_impact_isotropic(p.mass, p.J, st, e, eps_t);
+  RigidBody body;
+  body.mass = p.mass;
+  body.inertia = Eigen::Matrix3d::Identity() * p.J;
+  return solve_impact(body, st, e, p.law);
+}
 
 // The lowest asperity for a down direction d_new that is delta = |d_new - d_old| away from a
 // direction already queried. Keys are squared chords, so every other centre keeps
@@ -141,7 +154,11 @@ void run_explicit(std::uint64_t i, BounceVariant v, const BounceExperiment& b, c
       out.cut = true;
       break;
     }
-    const auto res = solve_impact_isotropic(p.mass, p.J, st, (*p.eps_n)(-vn), b.eps_t);
+    const auto res = sphere_impact(p, st, (*p.eps_n)(-vn), b.eps_t);
+    if (!res) {  // the process' own test of approach (cannot differ from vn < 0 above by more than rounding)
+      out.cut = true;
+      break;
+    }
     const double h0 = -st.r.z();
     const float spin_before = static_cast<float>(W.norm());
     V = res->V_after, W = res->Omega_after;
@@ -224,7 +241,7 @@ Flight ballistic_flight(double h0, double vz, double D, double g) {
 }
 
 BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b, BounceVariant v, std::uint64_t seed,
-                          int threads) {
+                          int threads, const Progress& progress) {
   validate(sphere);
   validate(b);
   if (b.omega != Vec3::Zero())
@@ -236,7 +253,12 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   p.mass = 4.0 / 3.0 * std::numbers::pi * p.R * p.R * p.R * b.density;
   p.J = 0.4 * p.mass * p.R * p.R;  // central sphere only (paper Sec. II)
   p.eps_n = en.get();
+  p.law = b.tangential;
   const bool explicit_geometry = v == BounceVariant::random_orientation || v == BounceVariant::dynamic;
+  if (!explicit_geometry && b.tangential.model != TangentialLaw::Model::kinematic)
+    throw std::invalid_argument("bounce: the tangential law " + b.tangential.describe() + " applies to the explicit variants "
+                                "(random-orientation, dynamic); variant " + std::string(to_string(v)) +
+                                " is the paper's procedure with its kinematic law");
   if (explicit_geometry) check_asperity_count(sphere.asperities, "bounce: asperities");
 
   BounceSamples s;
@@ -244,7 +266,7 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   s.sequences = b.sequences;
   s.sphere = sphere;
   s.first_speed = b.speed;
-  const std::uint64_t chunk = 4096;
+  const std::uint64_t chunk = kBounceBlock;
   std::vector<SequenceOut> outs(static_cast<std::size_t>(std::min(chunk, b.sequences)));
   const int nt = threads > 0 ? threads : omp_get_max_threads();
   for (std::uint64_t start = 0; start < b.sequences; start += chunk) {
@@ -273,6 +295,8 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
       s.no_impacts += o.cut ? 1 : 0;
       s.cells += o.cells, s.centres += o.centres;
     }
+    // Outside the parallel region: an exception from the callback leaves through here.
+    if (progress) progress(start + static_cast<std::uint64_t>(m), b.sequences);
   }
   s.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return s;
@@ -447,11 +471,16 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
 }
 
 std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& sphere, const BounceExperiment& b,
-                                                       std::uint64_t seed, int threads, std::ostream* log) {
+                                                       std::uint64_t seed, int threads, std::ostream* log,
+                                                       const Progress& progress) {
   std::vector<BounceVariantReport> out;
+  const std::uint64_t total = b.sequences * b.variants.size();
   for (auto v : b.variants) {
     const auto t0 = Clock::now();
-    const BounceSamples s = run_bounces(sphere, b, v, seed, threads);
+    const std::uint64_t offset = b.sequences * out.size();
+    Progress in_variant;
+    if (progress) in_variant = [&](std::uint64_t done, std::uint64_t) { progress(offset + done, total); };
+    const BounceSamples s = run_bounces(sphere, b, v, seed, threads, in_variant);
     out.push_back(analyse_bounces(s, b, seed));
     if (log)
       *log << "bounce " << to_string(v) << ": " << s.sequences << " sequences, " << s.eps.size() << " impacts, run "

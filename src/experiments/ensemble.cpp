@@ -202,7 +202,11 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
     const double vn = (st.V + st.Omega.cross(st.r)).dot(st.n);
     if (!(vn < 0)) continue;
     const double e = (*eps_n)(-vn);
-    const auto out = solve_impact_isotropic(mass, inertia, st, e, x.eps_t);
+    // The paper's kinematic law in closed form; another tangential law by its impulse process.
+    const auto out = x.tangential.model == TangentialLaw::Model::kinematic
+                         ? solve_impact_isotropic(mass, inertia, st, e, x.eps_t)
+                         : solve_impact(RigidBody{mass, Eigen::Matrix3d::Identity() * inertia}, st, e, x.tangential);
+    if (!out) continue;
     hit[k] = 1, eps[k] = out->eps, wx[k] = out->Omega_after.x(), en[k] = e;
   } catch (...) {
 #pragma omp critical(asperity_impact_error)

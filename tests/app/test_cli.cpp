@@ -444,6 +444,19 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {M + " --radius 1e-3", "--radius: a mesh body's size"},
       {M + " --mode sampled", "--mode: 'sampled'"},
       {M + " --backend grid", "--backend: not used by a mesh body"},
+      // --tangential (issue 18): the whole value named, each way it can be wrong.
+      {"--preset fig4 --tangential friction:mu=1", "--tangential: 'friction:mu=1' has model 'friction'"},
+      {"--preset fig4 --tangential coulomb:mu=0.3", "'coulomb:mu=0.3' needs restitution=newton|poisson|energetic"},
+      {"--preset fig4 --tangential stronge", "'stronge' needs mu=VALUE"},
+      {"--preset fig4 --tangential stronge:mu=-1", "'stronge:mu=-1' tangential mu must be finite and >= 0"},
+      {"--preset fig4 --tangential stronge:mu=x", "--tangential mu: 'x' is not a number"},
+      {"--preset fig4 --tangential stronge:mu=0.3,beta0=1", "has beta0=1, not a key of model stronge"},
+      {"--preset fig4 --tangential stronge:mu=0.3,mu=1", "gives mu twice"},
+      {"--preset fig4 --tangential stronge:mu", "has 'mu' where KEY=VALUE belongs"},
+      {"--preset fig4 --tangential walton:mu=0.3,beta0=2", "beta0"},
+      {"--preset fig4 --tangential kinematic:eps_t=2", "has eps_t outside [-1, 1]"},
+      {"--preset fig3 --tangential stronge:mu=0.3", "--tangential: needs impacts"},
+      {"--preset fig6 --tangential stronge:mu=0.3", "material.tangential.model: coulomb (mu = 0.3, energetic) applies to the explicit variants"},
   };
   for (const auto& c : cases) {
     const CliRun r = run(c.args + " --out " + out.string());
@@ -456,7 +469,9 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
   // fixed on a level-radii scene once --asperity-radius made it the paper's run.
   for (const std::string& ok : std::vector<std::string>{"--mode fixed --spheres 2 --backend grid --asperities 500 --drops 200",
                                M + " --speed 1 --omega-x 0.1 --spheres 1",
-                               L + " --asperity-radius 1e-6 --mode fixed --spheres 3 --drops 300"}) {
+                               L + " --asperity-radius 1e-6 --mode fixed --spheres 3 --drops 300",
+                               "--preset fig4 --asperities 1000 --drops 400 --tangential coulomb:mu=0.3,restitution=poisson",
+                               "--preset fig6 --variant dynamic --sequences 20 --asperities 10000 --tangential walton:mu=0.3,beta0=0.5"}) {
     const CliRun r = run(ok + " --no-plots --out " + out.string());
     EXPECT_TRUE(r.status == 0 || r.status == 1) << ok << "\n" << r.out;
     fs::remove_all(out);
@@ -487,7 +502,7 @@ TEST(CliProgress, ShownOnlyWhenTheRunIsLong) {
     char buf[512] = {};
     const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
     const std::string text(buf, n);
-    EXPECT_NE(text.find("50% (50 / 100), 1.5 s"), std::string::npos) << text;
+    EXPECT_NE(text.find("50% (50 / 100), 1.5 s, about 2 s left"), std::string::npos) << text;  // ETA: 1.5 s x 50/50
     EXPECT_EQ(text.find("10 / 100"), std::string::npos) << text;
     EXPECT_NE(text.find("100% (100 / 100)"), std::string::npos) << text;
     // A terminal gets one line redrawn with \r; a file or pipe gets whole lines.

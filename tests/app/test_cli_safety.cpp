@@ -390,3 +390,24 @@ TEST(CliOutput, AClosedPipeAfterTheRunKeepsItsCompleteOutput) {
 }
 
 }  // namespace
+
+// Issue 17: a bounce run (fig6) interrupted in the middle of its sequences -- seen running by its
+// progress line -- exits 130 and leaves its output directory as it was (here: absent).
+TEST(CliOutput, SigintInTheMiddleOfABounceRunExits130AndLeavesNothing) {
+  const fs::path out = fresh_dir("bounce-sigint");
+  const fs::path log = out.string() + ".log";
+  const pid_t pid = spawn({"--preset", "fig6", "--variant", "dynamic", "--sequences", "50000", "--no-plots", "--out", out.string()}, log);
+  // Wait for the first progress line (after 1 s of running), at most 60 s on a loaded machine.
+  bool running = false;
+  for (int i = 0; i < 600 && !running; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    running = slurp(log).find("sequences:") != std::string::npos;
+  }
+  ::kill(pid, SIGINT);
+  const int status = wait_status(pid);
+  ASSERT_TRUE(running) << slurp(log);
+  EXPECT_EQ(status, 130) << slurp(log);
+  EXPECT_NE(slurp(log).find("interrupted by SIGINT"), std::string::npos) << slurp(log);
+  EXPECT_FALSE(fs::exists(out)) << "the output directory must not be created by an interrupted run";
+  fs::remove(log);
+}

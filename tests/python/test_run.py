@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import asperity
-from conftest import cli_report
+from conftest import cli_report, preset_dict
 
 # Wall-clock fields differ between two runs of the same scene; everything else must be equal.
 VOLATILE = {"timings_s", "seconds", "wall_s"}
@@ -148,3 +148,35 @@ def test_bad_progress_raises_value_error():
 def test_presets():
     assert "fig3" in asperity.presets()
     assert "N = 1e5" in asperity.preset_text("fig3") or "fig3" in asperity.preset_text("fig3")
+
+
+def bounce_scene(tmp_path, sequences, variants="paper,random-orientation"):
+    """fig6 with fewer sequences and no plots (issue 17: bounce runs report progress, Ctrl-C)."""
+    s = preset_dict("fig6")
+    s["experiment"].update(sequences=sequences, variants=variants)
+    s["outputs"].update(plots=False, dir=str(tmp_path / "out-bounce"))
+    path = tmp_path / "bounce.toml"
+    path.write_text(asperity.scene_toml(s))
+    return path
+
+
+def test_bounce_progress_counts_sequences_of_every_variant(tmp_path):
+    calls = []
+    asperity.run(bounce_scene(tmp_path, 3000), progress=lambda done, total: calls.append((done, total)))
+    assert calls, "progress never called in a bounce run"
+    assert all(t == 6000 and 0 < d <= t for d, t in calls)
+    assert [d for d, _ in calls] == sorted(d for d, _ in calls)
+    assert calls[-1][0] == 6000
+
+
+def test_ctrl_c_interrupts_a_bounce_run(tmp_path):
+    # 10^6 sequences would take minutes; SIGINT after 0.3 s must end the run at the next block of
+    # sequences (1024), long before.
+    done = []
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        asperity.run(bounce_scene(tmp_path, 1_000_000, "random-orientation"), progress=lambda d, t: done.append(d))
+    timer.join()
+    assert max(done, default=0) < 500_000
+    assert not (tmp_path / "out-bounce").exists()

@@ -61,6 +61,10 @@ class LazySphere {
  private:
   struct Node {
     double z0, z1, p0, p1;
+    // Cached per cell because every query re-bounds the cached cells: acos of z0, z1 (the split
+    // rule's polar extent, computed exactly as before so the sphere is the same sample) and
+    // cos, sin of p0, p1 (the bound's phi part without a cos per call).
+    double t0, t1, c0, s0, c1, s1;
     std::uint64_t id;      // heap numbering: root 1, children 2 id and 2 id + 1
     std::uint64_t count;   // centres in the cell
     std::uint64_t offset;  // global index of its first centre
@@ -70,7 +74,11 @@ class LazySphere {
   bool is_leaf(const Node& c) const { return c.count <= leaf_size_ || c.id >= (std::uint64_t{1} << 60); }
   void expand(std::size_t i);
   void fill(std::size_t i);
-  static double lower_key(const Node& c, const Vec3& d, double dxy, double psi);
+  struct Direction {  // a query's down direction d, with dxy = |(d_x, d_y)|, psi its azimuth
+    Vec3 d;
+    double dxy, psi, cpsi, spsi;
+  };
+  static double lower_key(const Node& c, const Direction& q);
 
   std::uint64_t n_, seed_, sphere_;
   unsigned leaf_size_;

@@ -43,6 +43,7 @@
 #include <vector>
 
 #include "asperity/core/geometry.hpp"
+#include "asperity/experiments/ensemble.hpp"
 #include "asperity/laws/laplace.hpp"
 #include "asperity/laws/statistics.hpp"
 #include "asperity/laws/verdict.hpp"
@@ -67,6 +68,11 @@ struct BounceExperiment {
   double density = 7850;     ///< [kg/m^3] (eps does not depend on it)
   double beta = 0.0467;      ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
   double eps_t = 1.0;        ///< tangential restitution (paper: 1)
+  /// The tangential law of the explicit variants (core/tangential.hpp): kinematic (the default)
+  /// uses eps_t above; coulomb, stronge and walton solve each impact with solve_impact. The paper
+  /// variants are the paper's kinematic law and refuse anything else (run_bounces). Mesh-body
+  /// bounces take their law from MeshBounceOptions::tangential instead.
+  TangentialLaw tangential;
   unsigned max_impacts = 100000;  ///< safety bound per sequence
   std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
                                   ///< max(19, 2e7/n): the work is B n; the count used is reported)
@@ -118,8 +124,12 @@ struct Flight {
 Flight ballistic_flight(double h0, double vz, double D, double g);
 
 /// Runs `sequences` sequences of one variant for a sphere (N, R, a). threads = 0: OpenMP default.
+/// progress(done, total) is called from the calling thread between blocks of sequences (at most
+/// kBounceBlock each, well under a second); an exception it throws (the Python module's
+/// KeyboardInterrupt) ends the run and comes out of this call. Results do not depend on the blocks.
+inline constexpr std::uint64_t kBounceBlock = 1024;
 BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b, BounceVariant v, std::uint64_t seed,
-                          int threads = 0);
+                          int threads = 0, const Progress& progress = {});
 
 /// One group of impacts (a speed window or an impact number) and its fit.
 struct BounceGroup {
@@ -190,9 +200,10 @@ std::vector<BounceComparison> compare_bounce_variants(const std::vector<BounceVa
 BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperiment& b, std::uint64_t seed);
 
 /// Runs and analyses every variant of `b` in turn (samples are freed after each analysis); writes a
-/// line per variant to `log` if given.
+/// line per variant to `log` if given; progress counts sequences over all variants.
 std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& sphere, const BounceExperiment& b,
-                                                       std::uint64_t seed, int threads = 0, std::ostream* log = nullptr);
+                                                       std::uint64_t seed, int threads = 0, std::ostream* log = nullptr,
+                                                       const Progress& progress = {});
 
 /// Which grouping answers which question, and when window selection by the past biases it.
 std::string bounce_grouping_note();

@@ -76,7 +76,8 @@ struct ImpactExperiment {
   double beta = 0.0467;          ///< viscoelastic Pade [1/4] constant of Eq. 9 [(s/m)^(1/5)]
   double eps_t = 1.0;            ///< tangential restitution (paper: 1)
   /// The tangential law (core/tangential.hpp). kinematic (the default) uses eps_t above; coulomb and
-  /// walton apply to mesh-body runs (single impacts and bounces); sphere runs refuse them for now.
+  /// walton solve each impact with core/tangential solve_impact (sphere and mesh-body impacts and
+  /// bounces; the paper's bounce procedure refuses them, scene.cpp validate).
   TangentialLaw tangential;
 
   friend bool operator==(const ImpactExperiment&, const ImpactExperiment&) = default;

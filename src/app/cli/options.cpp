@@ -8,6 +8,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "asperity/app/scene_file.hpp"
@@ -134,6 +137,7 @@ struct RawOptions {
   std::string scene_file;
   std::string speed, omega_x, omega_y;
   std::string variants, sequences;
+  std::string tangential;
 };
 
 void add_options(CLI::App& app, RawOptions& r) {
@@ -158,6 +162,9 @@ void add_options(CLI::App& app, RawOptions& r) {
   app.add_option("--omega-y", r.omega_y, "impact: spin Omega_y before [rad/s]");
   app.add_option("--variant", r.variants, "bounce runs (fig6): comma list of paper, paper-printed33, paper-corrected28, random-orientation, dynamic");
   app.add_option("--sequences", r.sequences, "bounce runs (fig6): bounce sequences per variant");
+  app.add_option("--tangential", r.tangential,
+                 "tangential law of the impacts: kinematic[:eps_t=E], coulomb:mu=M,restitution=newton|poisson|energetic, "
+                 "stronge:mu=M, walton:mu=M,beta0=B (sphere impacts, the explicit bounce variants, mesh bodies)");
   app.add_flag("--no-plots", r.no_plots, "do not write PNG figures");
   app.add_flag("--quiet,-q", r.quiet, "print no progress");
 }
@@ -340,6 +347,80 @@ void apply_bounce_options(Scene& scene, const RawOptions& r, const Given& given)
   if (given("--variant")) scene.bounce.variants = parse_variants(r.variants);
 }
 
+// --tangential MODEL[:KEY=VALUE[,KEY=VALUE]] (material.tangential of scenes): every key once, each
+// known to its model, the model's required keys given; a bad one is named with the whole value.
+TangentialLaw parse_tangential(const std::string& text) {
+  const std::string opt = "--tangential";
+  auto bad = [&](const std::string& why) { return BadInput(opt + ": '" + text + "' " + why); };
+  const std::size_t colon = text.find(':');
+  const std::string model = text.substr(0, colon);
+  std::map<std::string, std::string> kv;
+  if (colon != std::string::npos) {
+    std::size_t pos = colon + 1;
+    do {
+      const std::size_t comma = text.find(',', pos);
+      const std::string item = text.substr(pos, comma - pos);
+      const std::size_t eq = item.find('=');
+      if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+        throw bad("has '" + item + "' where KEY=VALUE belongs (e.g. coulomb:mu=0.3,restitution=energetic)");
+      if (!kv.emplace(item.substr(0, eq), item.substr(eq + 1)).second) throw bad("gives " + item.substr(0, eq) + " twice");
+      pos = comma == std::string::npos ? comma : comma + 1;
+    } while (pos != std::string::npos);
+  }
+  std::vector<std::string> keys;  // the model's keys, for the check of unknown ones
+  auto real = [&](const std::string& key, bool required) -> std::optional<double> {
+    keys.push_back(key);
+    const auto it = kv.find(key);
+    if (it == kv.end()) {
+      if (required) throw bad("needs " + key + "=VALUE for model " + model);
+      return std::nullopt;
+    }
+    return parse_real(opt + " " + key, it->second);
+  };
+  TangentialLaw law;
+  if (model == "kinematic") {
+    law = TangentialLaw::kinematic(real("eps_t", false).value_or(1.0));
+    if (law.eps_t < -1 || law.eps_t > 1) throw bad("has eps_t outside [-1, 1]");
+  } else if (model == "coulomb") {
+    const double mu = *real("mu", true);
+    keys.push_back("restitution");
+    const auto it = kv.find("restitution");
+    if (it == kv.end()) throw bad("needs restitution=newton|poisson|energetic for model coulomb");
+    try {
+      law = TangentialLaw::coulomb(mu, parse_normal_rule(it->second));
+    } catch (const std::invalid_argument&) {
+      throw bad("has restitution=" + it->second + " (known: newton, poisson, energetic)");
+    }
+  } else if (model == "stronge") {
+    law = TangentialLaw::stronge(*real("mu", true));
+  } else if (model == "walton") {
+    const double mu = *real("mu", true);
+    law = TangentialLaw::walton(mu, *real("beta0", true));
+  } else {
+    throw bad("has model '" + model + "' (known: kinematic, coulomb, stronge, walton)");
+  }
+  for (const auto& [k, v] : kv)
+    if (std::find(keys.begin(), keys.end(), k) == keys.end()) throw bad("has " + k + "=" + v + ", not a key of model " + model);
+  try {
+    validate(law);
+  } catch (const std::invalid_argument& ex) {
+    throw bad(ex.what());
+  }
+  return law;
+}
+
+void apply_tangential_option(Scene& scene, const RawOptions& r, const RunKind& k) {
+  const TangentialLaw law = parse_tangential(r.tangential);
+  if (k.radii) refuse("--tangential", k.text + " is analysed as contacts only (no impacts)");
+  auto& x = scene.ensemble.impact;
+  if (!x.enabled && !scene.bounce.enabled)
+    refuse("--tangential", "needs impacts: give --speed, or a preset with impacts (fig4, fig5) or bounces (fig6)");
+  x.tangential = law;
+  // eps_t belongs to the kinematic law; any other law leaves it at the paper's 1.
+  x.eps_t = law.model == TangentialLaw::Model::kinematic ? law.eps_t : 1.0;
+  scene.bounce.eps_t = x.eps_t;
+}
+
 // --threads, --alpha, --no-plots, --out; and the scene's name says when options changed the physics.
 void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
   if (given("--threads")) {
@@ -361,7 +442,7 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
   }
   if (!given("--scene") && r.preset_name != scene.name) scene.name = r.preset_name;
   if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
-      given("--speed") || given("--omega-x") || given("--omega-y"))
+      given("--speed") || given("--omega-x") || given("--omega-y") || given("--tangential"))
     scene.name += "+custom";
 }
 
@@ -375,6 +456,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   apply_impact_options(scene, r, given, k);
   if (given("--backend")) apply_backend_option(scene, r, k);
   apply_bounce_options(scene, r, given);
+  if (given("--tangential")) apply_tangential_option(scene, r, k);
   apply_run_options(scene, r, given);
   validate(scene);
   return scene;

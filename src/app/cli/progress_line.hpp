@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <ostream>
+#include <streambuf>
 #include <string>
 
 namespace asperity::cli {
@@ -30,14 +32,19 @@ class ProgressLine {
     const double now = clock_(), elapsed = now - start_;
     if (elapsed < quiet_for_) return;  // short runs stay quiet
     const int pct = static_cast<int>(100.0 * double(done) / double(total));
+    // The ETA extrapolates the rate so far (bounce runs: it includes the analyses of the variants
+    // done, so it is the remaining share of the whole run).
+    char eta[48] = "";
+    if (done > 0 && done < total)
+      std::snprintf(eta, sizeof eta, ", about %.0f s left", elapsed * double(total - done) / double(done));
     if (tty_) {
       if (shown_ && now - last_ < 0.25 && done < total) return;
-      std::fprintf(out_, "\r  %s: %3d%% (%llu / %llu), %.1f s", unit_.c_str(), pct, (unsigned long long)done,
-                   (unsigned long long)total, elapsed);
+      std::fprintf(out_, "\r  %s: %3d%% (%llu / %llu), %.1f s%s   ", unit_.c_str(), pct, (unsigned long long)done,
+                   (unsigned long long)total, elapsed, eta);
       shown_ = true;
     } else if (pct >= next_pct_) {
-      std::fprintf(out_, "  %s: %d%% (%llu / %llu), %.1f s\n", unit_.c_str(), pct, (unsigned long long)done,
-                   (unsigned long long)total, elapsed);
+      std::fprintf(out_, "  %s: %d%% (%llu / %llu), %.1f s%s\n", unit_.c_str(), pct, (unsigned long long)done,
+                   (unsigned long long)total, elapsed, eta);
       next_pct_ = pct / 10 * 10 + 10;
     }
     last_ = now;
@@ -47,6 +54,23 @@ class ProgressLine {
     if (shown_) std::fprintf(out_, "\n");
     shown_ = false;
   }
+
+  /// An std::ostream for log lines written between progress reports (bounce runs' per-variant
+  /// lines): each line first ends the overwritten progress line, so neither garbles the other.
+  class Log : private std::streambuf, public std::ostream {
+   public:
+    explicit Log(ProgressLine& p) : std::ostream(this), p_(p) {}
+
+   private:
+    int overflow(int c) override {
+      if (c == std::char_traits<char>::eof()) return std::char_traits<char>::not_eof(c);
+      if (at_start_) p_.finish();
+      at_start_ = c == '\n';
+      return std::fputc(c, p_.out_) == EOF ? std::char_traits<char>::eof() : c;
+    }
+    ProgressLine& p_;
+    bool at_start_ = true;
+  };
 
  private:
   bool on_, tty_;

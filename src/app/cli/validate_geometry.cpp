@@ -92,7 +92,8 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir) {
   const bool sequences = run_kind(scene) == RunKind::mesh_bounce || run_kind(scene) == RunKind::bounce;
   ProgressLine progress(!quiet, stderr, ::isatty(2) != 0, &ProgressLine::steady_seconds, 1.0,
                         sequences ? "sequences" : "drops");
-  const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &std::cerr, staging->dir());
+  ProgressLine::Log log(progress);
+  const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &log, staging->dir());
   progress.finish();
   for (const auto& f : r.files) staging->add(f);
   const auto reports = write_report_files(staging->dir(), scene.report, r.json, r.table);
