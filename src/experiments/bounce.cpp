@@ -302,15 +302,12 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   return s;
 }
 
-BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperiment& b, std::uint64_t seed) {
-  BounceVariantReport r;
-  r.variant = s.variant;
-  r.sequences = s.sequences, r.impacts = s.eps.size(), r.no_impacts = s.no_impacts, r.seconds = s.seconds;
-  const double ns = static_cast<double>(std::max<std::uint64_t>(1, s.sequences));
-  r.impacts_per_sequence = static_cast<double>(r.impacts) / ns;
-  r.cells_per_sequence = static_cast<double>(s.cells) / ns;
-  r.centres_per_sequence = static_cast<double>(s.centres) / ns;
-  // Spin before the last impact of each sequence; eps(times) - eps(velocities).
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Per sequence: the spin before its last impact; per impact: eps(times) - eps(velocities).
+void summarise_sequences(const BounceSamples& s, BounceVariantReport& r) {
   double spin_last = 0, sum = 0, sum2 = 0;
   std::size_t last = 0;
   for (std::size_t j = 0; j < s.eps.size(); ++j) {
@@ -322,151 +319,204 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
     }
   }
   r.spin_final_mean = last ? spin_last / static_cast<double>(last) : 0.0;
-  {
-    const auto en0 = viscoelastic_pade14(b.beta);
-    double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
-    std::size_t np = 0;
-    for (std::size_t j = 1; j < s.eps.size(); ++j) {
-      if (s.sequence[j] != s.sequence[j - 1] || s.number[j - 1] < 2) continue;  // k-1 >= 2: both after spin-up
-      const double x = s.eps[j - 1] - (*en0)(s.speed[j - 1]), y = s.eps[j] - (*en0)(s.speed[j]);
-      sx += x, sy += y, sxx += x * x, syy += y * y, sxy += x * y, ++np;
-    }
-    r.lag1_pairs = np;
-    if (np > 2) {
-      const double n = static_cast<double>(np);
-      const double cxy = sxy / n - sx / n * sy / n, vx = sxx / n - sx / n * sx / n, vy = syy / n - sy / n * sy / n;
-      r.lag1_correlation = {cxy / std::sqrt(vx * vy), 1.0 / std::sqrt(n)};
-    } else {
-      r.lag1_correlation = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
-    }
-  }
   if (r.time_n) {
     r.time_diff_mean = sum / static_cast<double>(r.time_n);
     r.time_diff_sd = std::sqrt(std::max(0.0, sum2 / static_cast<double>(r.time_n) - r.time_diff_mean * r.time_diff_mean));
   }
+}
 
-  const auto en = viscoelastic_pade14(b.beta);
-  // Semi-analytic residual laws per impact number (explicit variants and the paper's route).
-  std::vector<BounceResidualLaw> laws;
+// Correlation of consecutive residuals eps - eps_n(u) of one sequence (both impacts after the
+// first spin-up, k - 1 >= 2): the memory the paper's procedure keeps and explicit geometry does not.
+void lag1_residual_correlation(const BounceSamples& s, double beta, BounceVariantReport& r) {
+  const auto en0 = viscoelastic_pade14(beta);
+  double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+  std::size_t np = 0;
+  for (std::size_t j = 1; j < s.eps.size(); ++j) {
+    if (s.sequence[j] != s.sequence[j - 1] || s.number[j - 1] < 2) continue;
+    const double x = s.eps[j - 1] - (*en0)(s.speed[j - 1]), y = s.eps[j] - (*en0)(s.speed[j]);
+    sx += x, sy += y, sxx += x * x, syy += y * y, sxy += x * y, ++np;
+  }
+  r.lag1_pairs = np;
+  if (np > 2) {
+    const double n = static_cast<double>(np);
+    const double cxy = sxy / n - sx / n * sy / n, vx = sxx / n - sx / n * sx / n, vy = syy / n - sy / n * sy / n;
+    r.lag1_correlation = {cxy / std::sqrt(vx * vy), 1.0 / std::sqrt(n)};
+  } else {
+    r.lag1_correlation = {kNaN, kNaN};
+  }
+}
+
+// Semi-analytic residual laws per impact number (explicit variants and the paper's route).
+std::vector<BounceResidualLaw> residual_laws(const BounceSamples& s, const BounceExperiment& b) {
   const bool theory = s.sphere && (s.variant == BounceVariant::random_orientation || s.variant == BounceVariant::dynamic ||
                                    s.variant == BounceVariant::paper);
-  if (theory && !s.number.empty()) {
-    ImpactScene sc;
-    sc.asperities = s.sphere->asperities, sc.radius = s.sphere->radius, sc.asperity_radius = s.sphere->asperity_radius;
-    sc.beta = b.beta, sc.speed = s.first_speed;
-    laws = bounce_residual_laws(sc, *std::max_element(s.number.begin(), s.number.end()), s.variant == BounceVariant::paper);
+  if (!theory || s.number.empty()) return {};
+  ImpactScene sc;
+  sc.asperities = s.sphere->asperities, sc.radius = s.sphere->radius, sc.asperity_radius = s.sphere->asperity_radius;
+  sc.beta = b.beta, sc.speed = s.first_speed;
+  return bounce_residual_laws(sc, *std::max_element(s.number.begin(), s.number.end()), s.variant == BounceVariant::paper);
+}
+
+// The members of one group, in impact order, and the sums its statistics need.
+struct GroupSums {
+  std::vector<double> res;            ///< eps - eps_n(u)
+  std::vector<std::size_t> kcount;    ///< members per impact number (laws.size() + 1 entries)
+  double su = 0, sw = 0, sd = 0, sd2 = 0;
+  std::size_t nd = 0;
+  double cu = 0, cr = 0, cuu = 0, crr = 0, cur = 0;  ///< speed (shifted) and residual moments
+};
+
+template <class Member>
+GroupSums collect_group(const BounceSamples& s, const BounceExperiment& b, const Restitution& en, std::size_t laws,
+                        bool window, const Member& member, BounceGroup& g) {
+  GroupSums t;
+  t.kcount.assign(laws + 1, 0);
+  for (std::size_t j = 0; j < s.eps.size(); ++j) {
+    if (!member(j)) continue;
+    const double r = s.eps[j] - en(s.speed[j]);
+    t.res.push_back(r);
+    g.sorted.push_back(window ? r : s.eps[j]);
+    if (s.number[j] <= laws) ++t.kcount[s.number[j]];
+    const double du = s.speed[j] - b.speed;  // shifted for accuracy
+    t.cu += du, t.cr += r, t.cuu += du * du, t.crr += r * r, t.cur += du * r;
+    t.su += s.speed[j], t.sw += s.spin[j];
+    if (std::isfinite(s.eps_time[j])) {
+      const double d = s.eps_time[j] - s.eps[j];
+      t.sd += d, t.sd2 += d * d, ++t.nd;
+    }
   }
-  auto make_group = [&](std::string by, double lo, double hi, auto&& member, std::uint64_t index) {
-    BounceGroup g;
-    const bool window = by == "speed";
-    g.by = std::move(by), g.lo = lo, g.hi = hi;
-    g.quantity = window ? "eps-eps_n(u)" : "eps";
-    double su = 0, sw = 0, sd = 0, sd2 = 0;
-    std::size_t nd = 0;
-    std::vector<double> res;
-    std::vector<std::size_t> kcount(laws.size() + 1, 0);
-    double cu = 0, cr = 0, cuu = 0, crr = 0, cur = 0;
-    for (std::size_t j = 0; j < s.eps.size(); ++j) {
-      if (!member(j)) continue;
-      const double r = s.eps[j] - (*en)(s.speed[j]);
-      res.push_back(r);
-      g.sorted.push_back(window ? r : s.eps[j]);
-      if (s.number[j] <= laws.size()) ++kcount[s.number[j]];
-      const double du = s.speed[j] - b.speed;  // shifted for accuracy
-      cu += du, cr += r, cuu += du * du, crr += r * r, cur += du * r;
-      su += s.speed[j], sw += s.spin[j];
-      if (std::isfinite(s.eps_time[j])) {
-        const double d = s.eps_time[j] - s.eps[j];
-        sd += d, sd2 += d * d, ++nd;
-      }
-    }
-    if (res.size() > 2) {
-      const double n = static_cast<double>(res.size());
-      const double mr = cr / n, vr = std::max(0.0, crr / n - mr * mr), vu = std::max(0.0, cuu / n - cu / n * cu / n);
-      g.residual_mean = {mr, std::sqrt(vr / (n - 1))};
-      g.residual_std = std::sqrt(vr * n / (n - 1));
-      const double den = std::sqrt(vr * vu);
-      g.speed_residual_correlation = {den > 0 ? (cur / n - cu / n * mr) / den : std::numeric_limits<double>::quiet_NaN(),
-                                      1.0 / std::sqrt(n)};
-      std::sort(res.begin(), res.end());
-      try {
-        g.residual_fit = fit_asymmetric_laplace_sorted(res);
-        g.residual_fitted = res.size() >= 20;
-      } catch (const std::invalid_argument&) {
-        g.residual_fitted = false;
-      }
-      if (!laws.empty()) {
-        std::vector<std::pair<double, const BounceResidualLaw*>> mix;
-        for (std::size_t k = 1; k < kcount.size(); ++k)
-          if (kcount[k]) mix.push_back({static_cast<double>(kcount[k]) / n, &laws[k - 1]});
-        double wsum = 0;
-        for (const auto& m : mix) wsum += m.first;
-        if (!mix.empty() && wsum > 0.999999) {
-          g.has_theory = true;
-          g.theory_ks = ks_one_sample(res, [&mix](double t) {
-            double F = 0;
-            for (const auto& [w, L] : mix) F += w * L->cdf(t);
-            return F;
-          });
-          if (mix.size() == 1) g.theory_rate_below = mix[0].second->rate_below(), g.theory_rate_above = mix[0].second->rate_above();
-        }
-      }
-    }
-    g.n = g.sorted.size();
-    if (g.n) {
-      const double n = static_cast<double>(g.n);
-      g.mean_speed = su / n, g.spin_mean = sw / n;
-      double m = 0;
-      for (double e : g.sorted) m += e;
-      m /= n;
-      double v = 0;
-      for (double e : g.sorted) v += (e - m) * (e - m);
-      g.eps_std = g.n > 1 ? std::sqrt(v / (n - 1)) : 0.0;
-      g.eps_mean = {m, g.eps_std / std::sqrt(n)};
-    }
-    if (nd) {
-      const double mean = sd / static_cast<double>(nd);
-      const double var = std::max(0.0, sd2 / static_cast<double>(nd) - mean * mean);
-      g.eps_time_minus_eps = {mean, nd > 1 ? std::sqrt(var / static_cast<double>(nd - 1)) : std::numeric_limits<double>::quiet_NaN()};
+  return t;
+}
+
+// KS of the group's residuals against the mixture of the per-impact laws of its members.
+void residual_theory_test(GroupSums& t, const std::vector<BounceResidualLaw>& laws, BounceGroup& g) {
+  const double n = static_cast<double>(t.res.size());
+  std::vector<std::pair<double, const BounceResidualLaw*>> mix;
+  for (std::size_t k = 1; k < t.kcount.size(); ++k)
+    if (t.kcount[k]) mix.push_back({static_cast<double>(t.kcount[k]) / n, &laws[k - 1]});
+  double wsum = 0;
+  for (const auto& m : mix) wsum += m.first;
+  if (mix.empty() || !(wsum > 0.999999)) return;
+  g.has_theory = true;
+  g.theory_ks = ks_one_sample(t.res, [&mix](double x) {
+    double F = 0;
+    for (const auto& [w, L] : mix) F += w * L->cdf(x);
+    return F;
+  });
+  if (mix.size() == 1) g.theory_rate_below = mix[0].second->rate_below(), g.theory_rate_above = mix[0].second->rate_above();
+}
+
+// Residual mean, spread, speed correlation, Eq. 2 fit and the semi-analytic law of the residuals.
+void residual_statistics(GroupSums& t, const std::vector<BounceResidualLaw>& laws, BounceGroup& g) {
+  if (t.res.size() <= 2) return;
+  const double n = static_cast<double>(t.res.size());
+  const double mr = t.cr / n, vr = std::max(0.0, t.crr / n - mr * mr), vu = std::max(0.0, t.cuu / n - t.cu / n * t.cu / n);
+  g.residual_mean = {mr, std::sqrt(vr / (n - 1))};
+  g.residual_std = std::sqrt(vr * n / (n - 1));
+  const double den = std::sqrt(vr * vu);
+  g.speed_residual_correlation = {den > 0 ? (t.cur / n - t.cu / n * mr) / den : kNaN, 1.0 / std::sqrt(n)};
+  std::sort(t.res.begin(), t.res.end());
+  try {
+    g.residual_fit = fit_asymmetric_laplace_sorted(t.res);
+    g.residual_fitted = t.res.size() >= 20;
+  } catch (const std::invalid_argument&) {
+    g.residual_fitted = false;
+  }
+  if (!laws.empty()) residual_theory_test(t, laws, g);
+}
+
+// Mean speed and spin, mean and spread of the group's quantity, eps(times) - eps(velocities).
+void group_moments(const GroupSums& t, BounceGroup& g) {
+  g.n = g.sorted.size();
+  if (g.n) {
+    const double n = static_cast<double>(g.n);
+    g.mean_speed = t.su / n, g.spin_mean = t.sw / n;
+    double m = 0;
+    for (double e : g.sorted) m += e;
+    m /= n;
+    double v = 0;
+    for (double e : g.sorted) v += (e - m) * (e - m);
+    g.eps_std = g.n > 1 ? std::sqrt(v / (n - 1)) : 0.0;
+    g.eps_mean = {m, g.eps_std / std::sqrt(n)};
+  }
+  if (t.nd) {
+    const double mean = t.sd / static_cast<double>(t.nd);
+    const double var = std::max(0.0, t.sd2 / static_cast<double>(t.nd) - mean * mean);
+    g.eps_time_minus_eps = {mean, t.nd > 1 ? std::sqrt(var / static_cast<double>(t.nd - 1)) : kNaN};
+  } else {
+    g.eps_time_minus_eps = {kNaN, kNaN};
+  }
+}
+
+// Eq. 2 fitted to the (sorted) group and its parametric-bootstrap KS test.
+void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t index, BounceGroup& g) {
+  if (g.n < 20) return;
+  try {
+    g.fit = fit_asymmetric_laplace_sorted(g.sorted);
+    g.fitted = true;
+    // B adapts up to the smallest count whose floor 1/(1+B) is below alpha (ceil(1/alpha): 100 at
+    // alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
+    // for the big low-speed windows; a group left with floor >= alpha is undecided when no
+    // replicate reaches D (below), never accepted.
+    const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
+    const std::size_t B = b.bootstrap == 0 ? 0
+                                           : std::min<std::size_t>(std::max(b.bootstrap, B_floor),
+                                                                   std::max<std::size_t>(19, 20000000 / g.n));
+    if (b.bootstrap > 0) {
+      g.gof = laplace_gof(g.sorted, g.fit, B, seed, index);
+      // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
+      // when floor > alpha that is no verdict (the group can never reject at this B).
+      const double floor = 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap));
+      g.gof_verdict = verdict_at(g.gof.p, b.alpha);
+      if (g.gof_verdict == Verdict::accept && g.gof.p <= floor * (1 + 1e-9) && !(floor < b.alpha))
+        g.gof_verdict = Verdict::undecided;
     } else {
-      g.eps_time_minus_eps = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN()};
+      g.gof.p = kNaN, g.gof.D = 0;
     }
-    std::sort(g.sorted.begin(), g.sorted.end());
-    if (g.n >= 20) {
-      try {
-        g.fit = fit_asymmetric_laplace_sorted(g.sorted);
-        g.fitted = true;
-        // B adapts up to the smallest count whose floor 1/(1+B) is below alpha (ceil(1/alpha): 100 at
-        // alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
-        // for the big low-speed windows; a group left with floor >= alpha is undecided when no
-        // replicate reaches D (below), never accepted.
-        const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
-        const std::size_t B = b.bootstrap == 0 ? 0
-                                               : std::min<std::size_t>(std::max(b.bootstrap, B_floor),
-                                                                       std::max<std::size_t>(19, 20000000 / g.n));
-        if (b.bootstrap > 0) {
-          g.gof = laplace_gof(g.sorted, g.fit, B, seed, index);
-          // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
-          // when floor > alpha that is no verdict (the group can never reject at this B).
-          const double floor = 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap));
-          g.gof_verdict = verdict_at(g.gof.p, b.alpha);
-          if (g.gof_verdict == Verdict::accept && g.gof.p <= floor * (1 + 1e-9) && !(floor < b.alpha))
-            g.gof_verdict = Verdict::undecided;
-        } else {
-          g.gof.p = std::numeric_limits<double>::quiet_NaN(), g.gof.D = 0;
-        }
-      } catch (const std::invalid_argument&) {
-        g.fitted = false;  // e.g. all values equal
-      }
-    }
-    r.groups.push_back(std::move(g));
-  };
+  } catch (const std::invalid_argument&) {
+    g.fitted = false;  // e.g. all values equal
+  }
+}
+
+template <class Member>
+BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const std::vector<BounceResidualLaw>& laws,
+                       const Restitution& en, std::string by, double lo, double hi, const Member& member,
+                       std::uint64_t seed, std::uint64_t index) {
+  BounceGroup g;
+  const bool window = by == "speed";
+  g.by = std::move(by), g.lo = lo, g.hi = hi;
+  g.quantity = window ? "eps-eps_n(u)" : "eps";
+  GroupSums t = collect_group(s, b, en, laws.size(), window, member, g);
+  residual_statistics(t, laws, g);
+  group_moments(t, g);
+  std::sort(g.sorted.begin(), g.sorted.end());
+  laplace_test(b, seed, index, g);
+  return g;
+}
+
+}  // namespace
+
+BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperiment& b, std::uint64_t seed) {
+  BounceVariantReport r;
+  r.variant = s.variant;
+  r.sequences = s.sequences, r.impacts = s.eps.size(), r.no_impacts = s.no_impacts, r.seconds = s.seconds;
+  const double ns = static_cast<double>(std::max<std::uint64_t>(1, s.sequences));
+  r.impacts_per_sequence = static_cast<double>(r.impacts) / ns;
+  r.cells_per_sequence = static_cast<double>(s.cells) / ns;
+  r.centres_per_sequence = static_cast<double>(s.centres) / ns;
+  summarise_sequences(s, r);
+  lag1_residual_correlation(s, b.beta, r);
+  const auto en = viscoelastic_pade14(b.beta);
+  const std::vector<BounceResidualLaw> laws = residual_laws(s, b);
   const std::uint64_t base = 1000000 + 1000 * static_cast<std::uint64_t>(s.variant);
   std::uint64_t gi = 0;
   for (const auto& [lo, hi] : b.windows)
-    make_group("speed", lo, hi, [&, lo = lo, hi = hi](std::size_t j) { return s.speed[j] >= lo && s.speed[j] <= hi; }, base + gi++);
+    r.groups.push_back(make_group(s, b, laws, *en, "speed", lo, hi,
+                                  [&, lo = lo, hi = hi](std::size_t j) { return s.speed[j] >= lo && s.speed[j] <= hi; },
+                                  seed, base + gi++));
   for (unsigned k : b.impact_numbers)
-    make_group("impact", k, k, [&](std::size_t j) { return s.number[j] == k; }, base + gi++);
+    r.groups.push_back(make_group(s, b, laws, *en, "impact", k, k, [&](std::size_t j) { return s.number[j] == k; }, seed,
+                                  base + gi++));
   return r;
 }
 
