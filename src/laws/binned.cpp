@@ -71,7 +71,8 @@ std::uint64_t BinnedStats::n() const {
 std::size_t BinnedStats::fine_bin(double u) const {
   // u 2^k is exact (a power of two); its floor shifted right is the coarse bin: the two agree.
   const double b = std::floor(u * double(fine_bins()));
-  return b >= double(fine_bins()) ? fine_bins() - 1 : b <= 0 ? 0 : static_cast<std::size_t>(b);
+  if (!(b > 0)) return 0;  // NaN too: never an index out of range
+  return b >= double(fine_bins()) ? fine_bins() - 1 : static_cast<std::size_t>(b);
 }
 
 Moments BinnedStats::moments() const {
