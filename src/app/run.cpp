@@ -22,6 +22,7 @@
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/scene_file.hpp"
+#include "asperity/app/stream_report.hpp"
 
 namespace asperity {
 
@@ -276,6 +277,7 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
 GeometryReport run_scene(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
   validate(s);
   Plan plan = make_plan(s);
+  if (uses_streaming(plan.scene.ensemble)) return run_stream_scene(std::move(plan), s, progress, dir);
   const Scene& run = plan.scene;
   const ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
   auto t0 = Clock::now();

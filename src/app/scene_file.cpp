@@ -454,7 +454,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
     } else if (s.radii && !s.mesh) {
       e.mode = Mode::sampled;  // unequal radii on a sphere: the exact sampler is their only design
     }
-    if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
+    if (auto d = ens->count("drops", 2, kMaxStreamingDrops)) e.drops = *d;  // > 2^31: streaming only (validate)
     const toml::node* k_node = ens->has("spheres") ? ens->find("spheres") : nullptr;
     if (k_node && k_node->as_string() && k_node->as_string()->get() == "auto") {
       s.spheres_auto = true;
@@ -489,6 +489,8 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
                             "from the exact law): \"auto\" or absent, got \"" + *b + "\"");
     }
     if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
+    if (auto st = ens->choice("statistics", {"auto", "raw", "streaming"})) e.statistics = parse_statistics(*st);
+    if (auto b = ens->count("bins_log2", 10, 24)) e.bins_log2 = static_cast<unsigned>(*b);
     ens->finish();
   }
 
@@ -857,7 +859,10 @@ std::string to_toml(const Scene& s) {
   else
     os << e.seed;
   os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::sampled ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
-     << e.threads << "\n\n";
+     << e.threads << "\n";
+  if (e.statistics != Statistics::automatic) os << "statistics = \"" << to_string(e.statistics) << "\"\n";
+  if (e.bins_log2 != EnsembleConfig{}.bins_log2) os << "bins_log2 = " << e.bins_log2 << "\n";
+  os << "\n";
   if (s.bounce.enabled) {
     const auto& b = s.bounce;
     os << "[experiment]\nkind = \"bounce\"\nspeed = " << num(b.speed) << "\nstop_speed = " << num(b.stop_speed)

@@ -133,7 +133,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
                "Gunkelmann, Montaine & Poeschel, PRE 89, 022205 (2014). Lengths in metres.",
                "validate-geometry"};
   std::string preset_name = "fig3", asperities, radius, asperity_radius, drops, spheres, mode, backend, seed, out;
-  std::string threads, alpha;
+  std::string threads, alpha, statistics, bins_log2;
   bool no_plots = false, quiet = false;
   std::string scene_file;
   auto* preset_opt = app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
@@ -150,6 +150,10 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   app.add_option("--seed", seed, "random seed (results are identical for any thread count)");
   app.add_option("--backend", backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
   app.add_option("--threads", threads, "OpenMP threads (0 = all)");
+  app.add_option("--statistics", statistics,
+                 "auto (default: streaming above 2^25 drops without impacts), raw (every drop kept: exact KS, figures "
+                 "of every quantity) or streaming (integer histograms, memory independent of the drops; contact only)");
+  app.add_option("--bins-log2", bins_log2, "streaming: 2^k fine bins per quantity, k in [10, 24] (default 16)");
   app.add_option("--alpha", alpha, "significance level of each test, in (0,1)");
   app.add_option("--out", out, "output directory for report.json and figures");
   std::string speed, omega_x, omega_y;
@@ -219,7 +223,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
                                                           : "levels") +
                                           "\")";
     if (given("--drops")) {
-      e.drops = parse_count("--drops", drops, 1, kMaxDrops);
+      e.drops = parse_count("--drops", drops, 1, kMaxStreamingDrops);  // > 2^31: streaming only (validate)
       if (bounce) refuse("--drops", "not used by " + kind + ", which counts bounce sequences: use --sequences");
     }
     if (given("--mode")) {
@@ -295,6 +299,10 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
         } while (pos != std::string::npos);
       }
     }
+    if (given("--statistics")) e.statistics = parse_statistics(statistics);
+    if (given("--bins-log2")) e.bins_log2 = static_cast<unsigned>(parse_count("--bins-log2", bins_log2, 10, 24));
+    if ((given("--statistics") || given("--bins-log2")) && (bounce || mesh || radii))
+      refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + kind + " (sphere contact runs only)");
     if (given("--threads")) {
       const std::uint64_t t = parse_count("--threads", threads, 0, std::uint64_t(kMaxThreads));
       e.threads = static_cast<int>(t);
