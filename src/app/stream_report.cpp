@@ -187,8 +187,8 @@ BandFigure finite_n_figure(const Scene& scene, const ContactStream& s) {
                              " rotations"
                        : std::string("sampled from the exact law, no geometry")) +
                  ", +-1 se between blocks (n = " + std::to_string(s.state.stats[0].n()) + ")";
-  // Every 8th coarse edge in the bulk (the tails carry nothing at this scale).
-  for (std::size_t j = 7; j < band.x.size(); j += 8) {
+  // Every 16th coarse edge in the bulk (the tails carry nothing at this scale).
+  for (std::size_t j = 15; j < band.x.size(); j += 16) {
     if (band.x[j] > 4 * s.state.stats[0].ref.sigma) break;
     f.x.push_back(band.x[j]);
     f.y.push_back(band.cdf[j] - eq14.cdf(band.x[j]));
@@ -224,7 +224,7 @@ void write_band_png(const std::filesystem::path& png, const BandFigure& fig) {
     for (char c : out.string()) path += c == '\'' ? std::string("''") : std::string(1, c);
     s << "set encoding utf8\nset terminal pngcairo size 900,650 enhanced font 'sans,12'\nset output " << path << "'\n"
       << "set title " << text(fig.title) << "\nset xlabel " << text(fig.xlabel) << "\nset ylabel " << text(fig.ylabel)
-      << "\nset key bottom right\nset grid\nplot $pts using 1:2:3 with yerrorbars pt 7 ps 0.6 lc rgb '#1f4e9c' title "
+      << "\nset key top left\nset grid\nplot $pts using 1:2:3 with yerrorbars pt 7 ps 0.6 lc rgb '#1f4e9c' title "
       << text(fig.data_label);
     const char* colours[] = {"#c0392b", "#555555"};
     for (std::size_t k = 0; k < fig.curves.size(); ++k)
