@@ -229,6 +229,9 @@ InterruptChild::~InterruptChild() {
 
 void set_interrupt_output_committed() { g_committed.store(true); }
 
+int interrupt_pending() { return g_pending.load(); }
+bool interrupt_cleanup_installed() { return g_installed.load(); }
+
 InterruptDeferral::InterruptDeferral() {
   int expected = 0;
   if (!g_phase.compare_exchange_strong(expected, 1)) wait_for_exit();

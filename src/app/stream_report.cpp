@@ -8,10 +8,14 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
+#include <iostream>
 #include <locale>
+#include <optional>
 #include <numbers>
 #include <sstream>
 
+#include "asperity/app/checkpoint.hpp"
+#include "asperity/app/interrupt.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/laws/binned.hpp"
@@ -96,8 +100,7 @@ void design_and_note(GeometryReport& r, const Scene& scene, const ContactStream&
          << " spatial query. ";
   else
     note << "sampled from the exact finite-N law of the lowest asperity -- no geometry; drops are iid. ";
-  note << "Statistics: " << r.statistics << "; no drop is kept (memory " << fmt(double(s.memory_bytes) / 1048576.0, 3)
-       << " MiB, independent of the drops). Decisive tests: KS of all drops on 2^" << kStreamCoarseLog2
+  note << "Statistics: " << r.statistics << "; no drop is kept (memory independent of the drops). Decisive tests: KS of all drops on 2^" << kStreamCoarseLog2
        << " cells with a sphere-block bootstrap p, and for r_xy the likelihood ratio of Eq. 14 against the exact "
           "finite-N law with its se from the spread between "
        << s.state.stats[0].blocks << " blocks of whole " << (expl ? "spheres" : "drops") << ".";
@@ -234,11 +237,47 @@ void write_band_png(const std::filesystem::path& png, const BandFigure& fig) {
   });
 }
 
+namespace {
+
+// The stream of `run` (the planned ensemble of scene s) with checkpoints in s.out (not the staging
+// directory: a checkpoint outlives an interrupted run): every s.checkpoint_seconds, and when a
+// signal arrives (validate-geometry: the signal waits for the end of a wave, the checkpoint is
+// written, then the signal ends the process as usual, exit 128 + signal).
+ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run, const Progress& progress,
+                                      const StreamHooks& given, const StreamState* resume) {
+  StreamState resumed;
+  if (!resume && s.resume) resumed = read_checkpoint(s.out, s), resume = &resumed;
+  using Clock = std::chrono::steady_clock;
+  auto last = Clock::now();
+  StreamHooks h = given;
+  if (!h.stop) h.stop = [] { return interrupt_pending() != 0; };
+  if (!h.checkpoint_due && s.checkpoint_seconds > 0)
+    h.checkpoint_due = [&] { return std::chrono::duration<double>(Clock::now() - last).count() >= s.checkpoint_seconds; };
+  if (!h.checkpoint)
+    h.checkpoint = [&](const StreamState& st) {
+      write_checkpoint(s.out, s, st);
+      last = Clock::now();
+    };
+  std::optional<InterruptDeferral> defer;
+  if (interrupt_cleanup_installed()) defer.emplace();
+  ContactStream cs = run_contact_stream(run, progress, h, resume);
+  if (!cs.complete) {
+    std::cerr << "\nvalidate-geometry: stopped after " << cs.state.stats[0].n() << " of " << run.drops
+              << " drops; checkpoint in " << (s.out / kCheckpointState).string()
+              << ": continue with validate-geometry --resume " << s.out.string() << "\n";
+    defer.reset();  // a pending signal ends the process here
+    throw std::runtime_error("the streaming run stopped before its last drop; checkpoint in " +
+                             (s.out / kCheckpointState).string());
+  }
+  return cs;
+}
+
+}  // namespace
+
 GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
                                 const StreamHooks& hooks, const StreamState* resume) {
   const Scene& run = plan.scene;
-  const ContactStream cs = run_contact_stream(run.ensemble, progress, hooks, resume);
-  if (!cs.complete) throw std::runtime_error("the streaming run stopped before its last drop (a checkpoint was written)");
+  const ContactStream cs = stream_with_checkpoints(s, run.ensemble, progress, hooks, resume);
   auto t0 = std::chrono::steady_clock::now();
   auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   GeometryReport r = analyse_stream(run, cs);

@@ -25,6 +25,7 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 constexpr std::uint64_t kUnit = 4096;         // rotations per unit (moments merged per unit, in order)
 constexpr std::uint64_t kWaveUnits = 16384;   // units per wave (merge, progress, stop, checkpoint between waves)
 constexpr std::uint64_t kBigSphereUnits = 16; // spheres of >= 16 units run their units in parallel
+constexpr std::uint64_t kWaveDrops = 1 << 18; // small spheres: at most this many drops per wave (or one sphere)
 constexpr std::size_t kQ = 3;                 // r_xy, r_x, r_y
 
 struct Slot {
@@ -225,7 +226,7 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
   while (u < total_units) {
     // A wave: up to kWaveUnits units; whole spheres unless the spheres are big.
     const std::uint64_t u1 = big ? std::min({total_units, u + kWaveUnits, (u / us + 1) * us})
-                                 : std::min(total_units, u + std::max<std::uint64_t>(1, kWaveUnits / us) * us);
+                                 : std::min(total_units, u + std::max<std::uint64_t>(1, std::min(kWaveUnits / us, kWaveDrops / m)) * us);
     slots.assign(u1 - u, Slot{});
     if (big) big_sphere_wave(dr, st, u, u1, slots, current, current_k, error);
     else small_sphere_wave(dr, st, u, u1, slots, error);
@@ -234,6 +235,7 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
                                std::to_string(st.check_queries) +
                                " re-answered queries disagree with the run's backend; first: " + error);
     merge_slots(st, sink, slots, u, us);
+    st.index_bytes = std::max<std::uint64_t>(st.index_bytes, dr.bytes);
     u = st.next_unit = u1;
     if (progress) progress(std::min(c.drops, (u / us) * m + (u % us) * kUnit), c.drops);
     const bool stop = u < total_units && hooks.stop && hooks.stop();
@@ -246,7 +248,8 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
   sink.fold();
   out.complete = st.next_unit >= total_units;
   out.seconds_generate = dr.gen, out.seconds_index = dr.idx, out.seconds_query = since(t0);
-  out.index_bytes = dr.bytes;
+  st.index_bytes = std::max<std::uint64_t>(st.index_bytes, dr.bytes);
+  out.index_bytes = static_cast<std::size_t>(st.index_bytes);
   out.cross_check.queries = st.check_queries, out.cross_check.agreed = st.check_agreed;
   for (const auto& s : st.stats)
     out.memory_bytes += (s.fine.size() * (1 + std::size_t(omp_get_max_threads())) + s.coarse.size()) * 8;

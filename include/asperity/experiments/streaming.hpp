@@ -34,6 +34,7 @@ struct StreamState {
   std::vector<BinnedStats> stats;     ///< one per kStreamQuantities
   std::uint64_t core_contacts = 0;
   std::uint64_t check_queries = 0, check_agreed = 0;
+  std::uint64_t index_bytes = 0;      ///< largest spatial index built so far
   friend bool operator==(const StreamState&, const StreamState&) = default;
 };
 
@@ -54,7 +55,7 @@ struct ContactStream {
   bool complete = false;
   std::uint64_t spheres = 0, rotations = 0;  ///< K and M (sampled: drops and 1)
   double seconds_generate = 0, seconds_index = 0, seconds_query = 0;
-  std::size_t index_bytes = 0;
+  std::size_t index_bytes = 0;  ///< largest index of the whole run (resumed runs included)
   CrossCheck cross_check;
   std::size_t memory_bytes = 0;  ///< of the statistics (all threads' histograms), independent of the drops
 };

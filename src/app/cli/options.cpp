@@ -133,7 +133,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
                "Gunkelmann, Montaine & Poeschel, PRE 89, 022205 (2014). Lengths in metres.",
                "validate-geometry"};
   std::string preset_name = "fig3", asperities, radius, asperity_radius, drops, spheres, mode, backend, seed, out;
-  std::string threads, alpha, statistics, bins_log2;
+  std::string threads, alpha, statistics, bins_log2, checkpoint_every, resume;
   bool no_plots = false, quiet = false;
   std::string scene_file;
   auto* preset_opt = app.add_option("--preset", preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
@@ -154,6 +154,12 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
                  "auto (default: streaming above 2^25 drops without impacts), raw (every drop kept: exact KS, figures "
                  "of every quantity) or streaming (integer histograms, memory independent of the drops; contact only)");
   app.add_option("--bins-log2", bins_log2, "streaming: 2^k fine bins per quantity, k in [10, 24] (default 16)");
+  app.add_option("--checkpoint-every", checkpoint_every,
+                 "streaming: seconds between checkpoints in --out (default 300; 0: only on SIGINT/SIGTERM)");
+  auto* resume_opt = app.add_option("--resume", resume,
+                                    "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only "
+                                    "--threads, --quiet, --no-plots, --checkpoint-every may be given)");
+  resume_opt->excludes(preset_opt);
   app.add_option("--alpha", alpha, "significance level of each test, in (0,1)");
   app.add_option("--out", out, "output directory for report.json and figures");
   std::string speed, omega_x, omega_y;
@@ -195,7 +201,20 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
   try {
     // Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
     auto given = [&](const char* name) { return app.count(name) > 0; };
-    Scene scene = !given("--scene") ? preset(preset_name) : load ? load(scene_file) : load_scene(scene_file);
+    if (given("--resume")) {
+      for (const char* o : {"--scene", "--asperities", "--radius", "--asperity-radius", "--drops", "--mode", "--spheres",
+                            "--seed", "--backend", "--alpha", "--out", "--speed", "--omega-x", "--omega-y", "--variant",
+                            "--sequences", "--statistics", "--bins-log2"})
+        if (given(o))
+          throw BadInput(std::string(o) + ": --resume continues the checkpoint's own scene; only --threads, --quiet, "
+                                          "--no-plots and --checkpoint-every may be given with it");
+      if (resume.empty()) throw BadInput("--resume: '' is not a directory name");
+    }
+    const std::string scene_path = given("--resume") ? (std::filesystem::path(resume) / "checkpoint.toml").string() : scene_file;
+    Scene scene = !given("--scene") && !given("--resume") ? preset(preset_name)
+                  : load                                 ? load(scene_path)
+                                                         : load_scene(scene_path);
+    if (given("--resume")) scene.out = resume, scene.resume = true;
     auto& e = scene.ensemble;
     // Options override the file (README "Scenes"). An option that cannot apply to the scene's
     // kind of run is an error naming it and why, never silently ignored.
@@ -299,6 +318,11 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
         } while (pos != std::string::npos);
       }
     }
+    if (given("--checkpoint-every")) {
+      scene.checkpoint_seconds = parse_real("--checkpoint-every", checkpoint_every);
+      if (!(scene.checkpoint_seconds >= 0) || !std::isfinite(scene.checkpoint_seconds))
+        throw BadInput("--checkpoint-every: '" + checkpoint_every + "' must be a finite number of seconds >= 0");
+    }
     if (given("--statistics")) e.statistics = parse_statistics(statistics);
     if (given("--bins-log2")) e.bins_log2 = static_cast<unsigned>(parse_count("--bins-log2", bins_log2, 10, 24));
     if ((given("--statistics") || given("--bins-log2")) && (bounce || mesh || radii))
@@ -320,7 +344,7 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
       if (out.empty()) throw BadInput("--out: '' is not a directory name");
       scene.out = out;
     }
-    if (!given("--scene") && preset_name != scene.name) scene.name = preset_name;
+    if (!given("--scene") && !given("--resume") && preset_name != scene.name) scene.name = preset_name;
     if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
         given("--speed") || given("--omega-x") || given("--omega-y"))
       scene.name += "+custom";

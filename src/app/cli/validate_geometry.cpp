@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "asperity/app/checkpoint.hpp"
 #include "asperity/app/interrupt.hpp"
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
@@ -93,6 +94,7 @@ int main(int argc, char** argv) {
     staging->add(reports.at(0).filename().string());
     staging->commit();
     staging.reset();
+    if (uses_streaming(scene.ensemble)) remove_checkpoint(scene.out);  // this run's (or the run it continued)
     std::cout << r.table;
     std::cout << "wrote " << (scene.out / scene.report).string() << ", " << reports.at(1).filename().string();
     for (const auto& f : r.files) std::cout << ", " << f;
