@@ -225,9 +225,9 @@ void write_band_png(const std::filesystem::path& png, const BandFigure& fig) {
     };
     std::string path = "'";
     for (char c : out.string()) path += c == '\'' ? std::string("''") : std::string(1, c);
-    s << "set encoding utf8\nset terminal pngcairo size 900,650 enhanced font 'sans,12'\nset output " << path << "'\n"
+    s << "set encoding utf8\nset terminal pngcairo size 900,720 enhanced font 'sans,12'\nset output " << path << "'\n"
       << "set title " << text(fig.title) << "\nset xlabel " << text(fig.xlabel) << "\nset ylabel " << text(fig.ylabel)
-      << "\nset key top left\nset grid\nplot $pts using 1:2:3 with yerrorbars pt 7 ps 0.6 lc rgb '#1f4e9c' title "
+      << "\nset key below Left reverse\nset grid\nplot $pts using 1:2:3 with yerrorbars pt 7 ps 0.6 lc rgb '#1f4e9c' title "
       << text(fig.data_label);
     const char* colours[] = {"#c0392b", "#555555"};
     for (std::size_t k = 0; k < fig.curves.size(); ++k)
