@@ -94,8 +94,9 @@ struct BinnedTest {
 };
 
 /// Binned KS against `cdf` (in x) over the 2^fine_log2 - 1 interior fine edges, x_j =
-/// ref.quantile(j 2^-k), with the law's exact probabilities F(x_j). p = Kolmogorov's (conservative
-/// for binned data: D on a grid is at most the continuous D). iid samples only.
+/// ref.quantile(j 2^-k), with the law's exact probabilities F(x_j). p = Kolmogorov's (D on a grid is
+/// at most the continuous D; calibration measured 0.058 +- 0.006 at alpha 0.05, 2^12 bins, n = 2e4,
+/// tests/laws/test_binned.cpp). iid samples only.
 BinnedTest binned_ks(const BinnedStats& s, const Cdf& cdf);
 
 /// Pearson chi^2 on `cells` cells of equal reference probability (fine bins merged), expected
