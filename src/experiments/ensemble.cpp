@@ -89,8 +89,9 @@ void validate(const EnsembleConfig& c) {
     throw std::invalid_argument("bins_log2 (2^k streaming bins) must be in [10, 24], got " + std::to_string(c.bins_log2));
   if (uses_streaming(c) && c.drops > kMaxStreamingDrops)
     throw std::invalid_argument("drops must be <= 2^50 for streaming statistics, got " + std::to_string(c.drops));
-  if (!uses_streaming(c) && c.drops > (std::uint64_t{1} << 31))
-    throw std::invalid_argument("drops must be <= 2^31 with raw samples (statistics = streaming goes further), got " +
+  // Beyond 2^31 only when streaming was asked for: a run of that size is a decision, never automatic.
+  if (c.statistics != Statistics::streaming && c.drops > (std::uint64_t{1} << 31))
+    throw std::invalid_argument("drops must be <= 2^31 unless statistics = streaming (--statistics streaming), got " +
                                 std::to_string(c.drops));
   if (c.mode == Mode::explicit_spheres) {
     if (c.spheres < 1) throw std::invalid_argument("spheres must be >= 1, got 0");

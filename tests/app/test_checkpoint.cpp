@@ -17,6 +17,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "asperity/app/scene.hpp"
+#include "asperity/app/scene_file.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
@@ -133,4 +135,14 @@ TEST(Checkpoint, DamagedOrForeignCheckpointsAreRefused) {
   EXPECT_NE(r.out.find("checkpoint"), std::string::npos) << r.out;
   EXPECT_EQ(slurp(dir / "checkpoint.bin"), "not a checkpoint") << "a refused checkpoint is left as it was";
   fs::remove_all(dir);
+}
+
+TEST(Checkpoint, SceneFilesKeepTheStatisticsKeys) {
+  asperity::Scene s = asperity::preset("fig3");
+  s.ensemble.statistics = asperity::Statistics::streaming;
+  s.ensemble.bins_log2 = 18;
+  const asperity::Scene back = asperity::parse_scene(asperity::to_toml(s));
+  EXPECT_EQ(back.ensemble.statistics, asperity::Statistics::streaming);
+  EXPECT_EQ(back.ensemble.bins_log2, 18u);
+  EXPECT_THROW(asperity::parse_scene("[ensemble]\nstatistics = \"fast\"\n"), std::invalid_argument);
 }

@@ -95,3 +95,24 @@ TEST(Streaming, RefusesImpactsAndMismatchedCheckpoints) {
   c.bins_log2 = 18;
   EXPECT_THROW(run_contact_stream(c, {}, {}, &other), std::invalid_argument);
 }
+
+TEST(Streaming, AutomaticStatisticsStreamOnlyLargeContactRuns) {
+  EnsembleConfig c = config(Mode::explicit_spheres, 50, 50 * 1000);
+  c.statistics = Statistics::automatic;
+  EXPECT_FALSE(uses_streaming(c));
+  c.drops = kStreamingAutoDrops + 50 - kStreamingAutoDrops % 50;
+  EXPECT_TRUE(uses_streaming(c));
+  c.impact.enabled = true;  // impacts need every drop: raw samples
+  EXPECT_FALSE(uses_streaming(c));
+  c.impact.enabled = false;
+  c.statistics = Statistics::raw;
+  c.drops = (std::uint64_t{1} << 31) + 50;
+  c.spheres = 2;
+  EXPECT_THROW(validate(c), std::invalid_argument);  // raw samples stop at 2^31
+  c.statistics = Statistics::streaming;
+  EXPECT_NO_THROW(validate(c));
+  c.bins_log2 = 25;
+  EXPECT_THROW(validate(c), std::invalid_argument);
+  EXPECT_EQ(parse_statistics("streaming"), Statistics::streaming);
+  EXPECT_THROW(parse_statistics("fast"), std::invalid_argument);
+}
