@@ -146,3 +146,46 @@ TEST(Checkpoint, SceneFilesKeepTheStatisticsKeys) {
   EXPECT_EQ(back.ensemble.bins_log2, 18u);
   EXPECT_THROW(asperity::parse_scene("[ensemble]\nstatistics = \"fast\"\n"), std::invalid_argument);
 }
+
+// A signal while the run's output goes to a closed pipe: the message after the checkpoint raises
+// SIGPIPE during the clean-up of the first signal; the run must still end (128 + SIGTERM), not
+// pause forever (it did before the clean-up blocked further signals).
+TEST(Checkpoint, ASignalWithAClosedPipeStillEndsTheRun) {
+  const fs::path out = fresh_dir("pipe");
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);
+    ::close(fds[0]);
+    ::dup2(fds[1], 1), ::dup2(fds[1], 2);
+    // Not -q: progress and the stop message go to the closed pipe.
+    std::vector<std::string> args{"--asperities", "1000", "--drops", "20000000", "--spheres", "50000", "--statistics",
+                                  "streaming", "--no-plots", "--checkpoint-every", "0.000001", "--out", out.string()};
+    std::vector<char*> argv;
+    std::string prog = vg();
+    argv.push_back(prog.data());
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(98);
+  }
+  ::close(fds[0]), ::close(fds[1]);  // no reader any more
+  for (int i = 0; i < 6000 && !fs::exists(out / "checkpoint.bin"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ::kill(pid, SIGTERM);
+  int st = 0, waited = 0;
+  while (::waitpid(pid, &st, WNOHANG) == 0 && waited < 120000) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    waited += 20;
+  }
+  if (waited >= 120000) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &st, 0);
+    FAIL() << "the run did not end within 120 s of SIGTERM";
+  }
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 128 + SIGTERM)
+      << "status " << st << (WIFSIGNALED(st) ? " killed by signal " + std::to_string(WTERMSIG(st)) : std::string());
+  fs::remove_all(out);
+}
