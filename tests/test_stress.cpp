@@ -442,7 +442,12 @@ TEST(StressCli, OutOfRangeValuesAreCleanErrors) {
                                        {"--speed 1 --omega-y -4e10", "4e+10"},
                                        {"--speed 1e-400", "1e-400"},
                                        {"--asperities 4294967295 --mode fixed --drops 2", "4294967295"},
-                                       {"--drops 2147483648", "2147483648"},
+                                       // raw samples of 2^31 drops do not fit (automatic statistics would stream them)
+                                       {"--drops 2147483648 --statistics raw", "2147483648"},
+                                       {"--drops 2147483649", "2147483649"},
+                                       {"--drops 1125899906842625 --statistics streaming", "1125899906842625"},
+                                       {"--drops 4000 --statistics streaming --speed 1", "streaming"},
+                                       {"--drops 4000 --statistics streaming --bins-log2 25", "25"},
                                        {"--alpha 1e-400", "1e-400"},
                                        {"--seed 18446744073709551616", "18446744073709551616"}}) {
     const fs::path out = scratch("bad");

@@ -110,6 +110,13 @@ void wait_for_creations(Slots& slots, long self, int& budget_ms) {
 bool live(const Slot& s) { return s.state.load() == kRegistered || s.state.load() == kCreating; }
 
 [[noreturn]] void clean_up_and_exit(int sig) {
+  // Called from a handler, or from ~InterruptDeferral in normal context: there a second signal
+  // (SIGPIPE from the message below on a closed pipe) would enter on_signal, find the phase taken
+  // and pause this thread forever. Blocked here, it waits; other threads that take it pause.
+  sigset_t all;
+  sigemptyset(&all);
+  for (int s : kSignals) sigaddset(&all, s);
+  ::pthread_sigmask(SIG_BLOCK, &all, nullptr);
   const long self = this_thread_id();
   int budget_ms = 2000;
   wait_for_creations(g_children, self, budget_ms);
@@ -228,6 +235,9 @@ InterruptChild::~InterruptChild() {
 }
 
 void set_interrupt_output_committed() { g_committed.store(true); }
+
+int interrupt_pending() { return g_pending.load(); }
+bool interrupt_cleanup_installed() { return g_installed.load(); }
 
 InterruptDeferral::InterruptDeferral() {
   int expected = 0;

@@ -226,6 +226,9 @@ void fill_counts(GeometryReport& r, const Scene& scene, const ContactSamples& s)
   r.core_probability_paper = core_contact_probability_paper(sp.asperities, sp.radius, sp.asperity_radius);
   r.index_bytes = s.index_bytes;
   r.cross_check = s.cross_check;
+  r.statistics = s.mode == Mode::explicit_spheres
+                     ? "raw samples, KS of all drops on a grid of pooled quantiles with a sphere-block bootstrap"
+                     : "raw samples, exact KS";
   std::vector<double> g = s.gap;
   const auto q = quantiles_unsorted(g, std::vector<double>{0.0, 0.5});
   r.gap_min = q[0];
@@ -562,6 +565,7 @@ std::string format_table(const GeometryReport& r) {
       for (std::size_t i = 0; i < r.cross_check.backends.size(); ++i) os << (i ? ", " : "") << r.cross_check.backends[i];
       os << ", " << r.cross_check.agreed << " agree";
     }
+    if (!r.statistics.empty()) os << "\nstatistics: " << r.statistics;
     os << "\nerror scales (KS distance): statistical " << fmt(d.statistical_scale, 3) << ", quenched "
        << fmt(d.quenched_scale, 3) << ", model error (Eq. 14 vs exact finite-N law) " << fmt(d.model_error_scale, 3) << "\n";
   }
@@ -671,6 +675,7 @@ std::string to_json(const GeometryReport& r) {
     j["eps_deficit"] = {{"value", r.eps_deficit.value}, {"se", r.eps_deficit.se}};
   }
   j["ensemble_note"] = r.ensemble_note;
+  if (!r.statistics.empty()) j["statistics"] = r.statistics;
   if (e.mode == Mode::explicit_spheres) j["quenched_deviation_scale"] = r.quenched_scale;
   j["design"] = design_json(r);
   if (r.design.kind == "explicit")

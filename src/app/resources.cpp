@@ -1,5 +1,7 @@
 #include "asperity/app/resources.hpp"
 
+#include "asperity/experiments/streaming.hpp"
+
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -81,7 +83,16 @@ MemoryEstimate estimate_memory(const Scene& s) {
       double per_drop = pe.mode == Mode::sampled ? kPerDropFresh : kPerDropFixed;
       if (pe.impact.enabled) per_drop = kPerDropImpact;
       m.bytes = kBaseSphere + per_drop * n;
-      d << count(e.drops) << " drops x " << per_drop << " B";
+      if (uses_streaming(pe)) {
+        // Streaming keeps no drop: 3 quantities x (a fine histogram per thread + the merged one +
+        // the per-block cells) x 8 B (experiments/streaming.hpp).
+        const double fine = std::ldexp(1.0, int(pe.bins_log2)), cells = double(kStreamBlocks << kStreamCoarseLog2);
+        m.bytes = kBaseSphere + 3 * 8 * (fine * (threads_of(s) + 1) + cells);
+        d << "streaming histograms (2^" << pe.bins_log2 << " bins x " << threads_of(s) + 1 << " + " << cells
+          << " cells, x 3 quantities x 8 B; no drop kept)";
+      } else {
+        d << count(e.drops) << " drops x " << per_drop << " B";
+      }
       if (pe.mode == Mode::explicit_spheres) {
         // One sphere: its rotations in parallel; K > 1 spheres: one sphere per busy thread
         // (ensemble.cpp), K from the plan (the error budget when spheres = "auto").

@@ -24,6 +24,8 @@
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/scene_file.hpp"
+#include "asperity/app/stream_report.hpp"
+#include "asperity/app/checkpoint.hpp"
 
 namespace asperity {
 
@@ -320,6 +322,7 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
 GeometryReport run_scene(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
   validate(s);
   Plan plan = make_plan(s);
+  if (uses_streaming(plan.scene.ensemble)) return run_stream_scene(std::move(plan), s, progress, dir);
   const Scene& run = plan.scene;
   const ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
   auto t0 = Clock::now();
@@ -366,6 +369,15 @@ std::string show(double v) {
 
 void check_scene_inputs(const Scene& s) {
   validate(s);
+  // A checkpoint in the output directory belongs to an interrupted streaming run: never overwritten.
+  const bool checkpoint = std::filesystem::exists(s.out / kCheckpointState);
+  if (s.resume && !uses_streaming(s.ensemble))
+    throw std::invalid_argument("--resume: the scene of " + s.out.string() + " does not stream (statistics = raw)");
+  if (s.resume && !checkpoint) throw std::invalid_argument("--resume: no checkpoint " + (s.out / kCheckpointState).string());
+  if (!s.resume && checkpoint && uses_streaming(s.ensemble))
+    throw std::invalid_argument("--out: " + (s.out / kCheckpointState).string() +
+                                " is the checkpoint of an interrupted run: continue it with --resume " + s.out.string() +
+                                ", or remove it");
   if (!s.mesh) return;
   const auto& m = *s.mesh;
   TriangleMesh mesh;

@@ -571,13 +571,15 @@ void read_ensemble(Reader& top, Scene& s) {
   if (!ens) return;
   auto& e = s.ensemble;
   read_mode(*ens, s);
-  if (auto d = ens->count("drops", 2, kMaxDrops)) e.drops = *d;
+  if (auto d = ens->count("drops", 2, kMaxStreamingDrops)) e.drops = *d;  // > 2^31: streaming only (validate)
   read_spheres(*ens, s);
   if (e.mode == Mode::explicit_spheres && !s.spheres_auto && e.drops % e.spheres != 0)
     ens->bad("drops", std::to_string(e.drops) + " must be a multiple of ensemble.spheres = " + std::to_string(e.spheres));
   read_seed(*ens, e.seed);
   read_backend(*ens, s);
   if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
+  if (auto st = ens->choice("statistics", {"auto", "raw", "streaming"})) e.statistics = parse_statistics(*st);
+  if (auto b = ens->count("bins_log2", 10, 24)) e.bins_log2 = static_cast<unsigned>(*b);
   ens->finish();
 }
 
@@ -1018,7 +1020,10 @@ void write_ensemble(std::ostream& os, const Scene& s) {
   else
     os << e.seed;
   os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::sampled ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
-     << e.threads << "\n\n";
+     << e.threads << "\n";
+  if (e.statistics != Statistics::automatic) os << "statistics = \"" << to_string(e.statistics) << "\"\n";
+  if (e.bins_log2 != EnsembleConfig{}.bins_log2) os << "bins_log2 = " << e.bins_log2 << "\n";
+  os << "\n";
 }
 
 void write_bounce(std::ostream& os, const BounceExperiment& b, bool mesh) {

@@ -15,6 +15,7 @@
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
 #include "core/format.hpp"
+#include "experiments/ensemble_detail.hpp"
 
 namespace asperity {
 
@@ -56,12 +57,42 @@ DesignScales design_scales(Mode mode, std::uint64_t asperities, std::uint64_t sp
   return s;
 }
 
+std::string_view to_string(Statistics s) {
+  switch (s) {
+    case Statistics::automatic: return "auto";
+    case Statistics::raw: return "raw";
+    case Statistics::streaming: return "streaming";
+  }
+  return "?";
+}
+
+Statistics parse_statistics(std::string_view s) {
+  if (s == "auto") return Statistics::automatic;
+  if (s == "raw") return Statistics::raw;
+  if (s == "streaming") return Statistics::streaming;
+  throw std::invalid_argument("unknown statistics '" + std::string(s) + "' (expected auto, raw or streaming)");
+}
+
+bool uses_streaming(const EnsembleConfig& c) {
+  if (c.statistics == Statistics::streaming) return true;
+  return c.statistics == Statistics::automatic && !c.impact.enabled && c.drops > kStreamingAutoDrops;
+}
+
 void validate(const EnsembleConfig& c) {
   validate(c.sphere);
   if (c.drops < 2)
     throw std::invalid_argument("drops must be >= 2 (a standard error needs two samples), got " + std::to_string(c.drops));
-  if (c.drops > (std::uint64_t{1} << 31))
-    throw std::invalid_argument("drops must be <= 2^31, got " + std::to_string(c.drops));
+  if (c.statistics == Statistics::streaming && c.impact.enabled)
+    throw std::invalid_argument("statistics = streaming keeps contact statistics only; the impact experiment needs "
+                                "statistics = raw (or auto)");
+  if (c.bins_log2 < 10 || c.bins_log2 > 24)
+    throw std::invalid_argument("bins_log2 (2^k streaming bins) must be in [10, 24], got " + std::to_string(c.bins_log2));
+  if (uses_streaming(c) && c.drops > kMaxStreamingDrops)
+    throw std::invalid_argument("drops must be <= 2^50 for streaming statistics, got " + std::to_string(c.drops));
+  // Beyond 2^31 only when streaming was asked for: a run of that size is a decision, never automatic.
+  if (c.statistics != Statistics::streaming && c.drops > (std::uint64_t{1} << 31))
+    throw std::invalid_argument("drops must be <= 2^31 unless statistics = streaming (--statistics streaming), got " +
+                                std::to_string(c.drops));
   if (c.mode == Mode::explicit_spheres) {
     if (c.spheres < 1) throw std::invalid_argument("spheres must be >= 1, got 0");
     if (c.drops % c.spheres != 0)
@@ -227,13 +258,7 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
 
 }  // namespace
 
-namespace {
-
-// Cross-check of one sphere's sampled queries by other exact backends (CrossCheck, ensemble.hpp).
-struct SphereCheck {
-  std::uint64_t queries = 0, agreed = 0;
-  std::string first_disagreement;
-};
+namespace detail {
 
 SphereCheck cross_check_sphere(const EnsembleConfig& c, std::span<const Vec3> centres,
                                const std::vector<std::pair<Vec3, Nearest>>& answers,
@@ -257,7 +282,27 @@ SphereCheck cross_check_sphere(const EnsembleConfig& c, std::span<const Vec3> ce
   return r;
 }
 
-}  // namespace
+}  // namespace detail
+
+namespace detail {
+
+CheckPlan check_plan(const EnsembleConfig& c) {
+  CheckPlan p;
+  const std::uint64_t n = c.sphere.asperities, K = c.spheres, m = c.drops / K;
+  p.others = cross_check_backends(c.backend, n);
+  const double budget = std::max(100.0, std::floor(kCrossCheckScanBudget / double(n)));
+  const auto total_checks = static_cast<std::uint64_t>(
+      std::min({double(c.drops), 1e4, std::max(100.0, std::min(0.01 * double(c.drops), budget))}));
+  // Spheres 0, s, 2s, ...: as many as the quota needs (one when a sphere has enough rotations: each
+  // checked sphere costs a kd-tree build, ~25 ms at N = 10^5).
+  p.spheres = std::min<std::uint64_t>(K, (total_checks + m - 1) / m);
+  p.sphere_stride = K / p.spheres;
+  p.per_sphere = std::max<std::uint64_t>(1, (total_checks + p.spheres - 1) / p.spheres);
+  p.stride = std::max<std::uint64_t>(1, m / p.per_sphere);
+  return p;
+}
+
+}  // namespace detail
 
 std::vector<Backend> cross_check_backends(Backend main, std::uint64_t asperities) {
   std::vector<Backend> b;
@@ -297,18 +342,11 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
   } else {
     s.batches = c.spheres;
     const std::uint64_t K = c.spheres, m = c.drops / K;
-    // Cross-check plan: spheres 0 and K-1, every `stride`-th rotation of each.
-    const std::vector<Backend> others = cross_check_backends(c.backend, n);
-    const double budget = std::max(100.0, std::floor(kCrossCheckScanBudget / double(n)));
-    const auto total_checks = static_cast<std::uint64_t>(
-        std::min({double(c.drops), 1e4, std::max(100.0, std::min(0.01 * double(c.drops), budget))}));
-    // Spheres 0, s, 2s, ...: as many as the quota needs (one when a sphere has enough rotations: each
-    // checked sphere costs a kd-tree build, ~25 ms at N = 10^5).
-    const std::uint64_t check_spheres = std::min<std::uint64_t>(K, (total_checks + m - 1) / m);
-    const std::uint64_t sphere_stride = K / check_spheres;
-    const std::uint64_t per_sphere = std::max<std::uint64_t>(1, (total_checks + check_spheres - 1) / check_spheres);
-    const std::uint64_t stride = std::max<std::uint64_t>(1, m / per_sphere);
-    auto is_checked = [&](std::uint64_t k) { return k % sphere_stride == 0 && k / sphere_stride < check_spheres; };
+    const detail::CheckPlan plan = detail::check_plan(c);
+    const std::vector<Backend>& others = plan.others;
+    const std::uint64_t check_spheres = plan.spheres, sphere_stride = plan.sphere_stride, per_sphere = plan.per_sphere,
+                        stride = plan.stride;
+    auto is_checked = [&](std::uint64_t k) { return plan.checked(k); };
 
     // Rotations [b, e) of sphere k, drops [k m + b, k m + e): the same streams whichever loop runs them.
     auto rotate = [&](const RoughSphere& body, const ContactQuery& index, std::uint64_t k, std::uint64_t b,
@@ -328,8 +366,8 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
         if (checks && j % stride == 0 && checks->size() < per_sphere) checks->emplace_back(d[j - b], r);
       }
     };
-    std::vector<SphereCheck> checks(check_spheres);
-    auto check_slot = [&](std::uint64_t k) -> SphereCheck& { return checks[k / sphere_stride]; };
+    std::vector<detail::SphereCheck> checks(check_spheres);
+    auto check_slot = [&](std::uint64_t k) -> detail::SphereCheck& { return checks[k / sphere_stride]; };
     double seconds_check = 0;
     if (K == 1) {
       // One sphere: its rotations in parallel.
@@ -351,7 +389,7 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
       for (const auto& f : found)
         for (const auto& x : f)
           if (answers.size() < per_sphere) answers.push_back(x);
-      checks[0] = cross_check_sphere(c, body.centres, answers, others, 0);
+      checks[0] = detail::cross_check_sphere(c, body.centres, answers, others, 0);
       seconds_check = since(t0);
     } else {
       // Spheres in parallel, each generated, indexed and queried by one thread: no parallel region
@@ -378,7 +416,7 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
           rotate(body, *index, k, b, std::min(m, b + kChunk), is_checked(k) ? &answers : nullptr);
         if (is_checked(k)) {
           t = Clock::now();
-          check_slot(k) = cross_check_sphere(c, body.centres, answers, others, k);
+          check_slot(k) = detail::cross_check_sphere(c, body.centres, answers, others, k);
           chk += since(t);
         }
         const std::uint64_t now = done.fetch_add(m) + m;

@@ -502,7 +502,7 @@ TEST(CliProgress, ShownOnlyWhenTheRunIsLong) {
     char buf[512] = {};
     const std::size_t n = std::fread(buf, 1, sizeof buf - 1, f);
     const std::string text(buf, n);
-    EXPECT_NE(text.find("50% (50 / 100), 1.5 s, about 2 s left"), std::string::npos) << text;  // ETA: 1.5 s x 50/50
+    EXPECT_NE(text.find("50% (50 / 100), 1.5 s, 33.3 drops/s, ETA 2 s"), std::string::npos) << text;  // 50 / 33.3
     EXPECT_EQ(text.find("10 / 100"), std::string::npos) << text;
     EXPECT_NE(text.find("100% (100 / 100)"), std::string::npos) << text;
     // A terminal gets one line redrawn with \r; a file or pipe gets whole lines.

@@ -65,4 +65,11 @@ class InterruptDeferral {
   InterruptDeferral& operator=(const InterruptDeferral&) = delete;
 };
 
+/// The signal recorded while an InterruptDeferral lives (0: none). A long run holds a deferral,
+/// polls this between units of work, writes a checkpoint and ends; the deferral's end then
+/// handles the signal as usual (clean-up, exit 128 + signal).
+int interrupt_pending();
+/// Whether install_interrupt_cleanup ran (a program, not a library user).
+bool interrupt_cleanup_installed();
+
 }  // namespace asperity

@@ -58,6 +58,8 @@ struct GeometryReport {
     double model_error_scale = 0;     ///< KS distance of Eq. 14 from the exact finite-N law
   } design;
   CrossCheck cross_check;             ///< queries re-answered by other backends (explicit)
+  /// Which path kept the drops (report.json "statistics"): "raw samples, ..." or "streaming histogram, 2^k bins ..."
+  std::string statistics;
   std::string ensemble_note;
   std::vector<QuantityReport> quantities;
   std::vector<TestReport> tests;

@@ -80,6 +80,10 @@ struct Scene {
   bool restitution_stats = true;
   std::filesystem::path out = "asperity-out";
   std::string report = "report.json";  ///< report file name inside `out`
+  /// Streaming runs only, how this run is driven (not written to scene files): a checkpoint every
+  /// checkpoint_seconds (0: only on SIGINT/SIGTERM) in `out`; resume: continue from it (app/checkpoint.hpp).
+  double checkpoint_seconds = 300;
+  bool resume = false;
 
   friend bool operator==(const Scene&, const Scene&) = default;
 

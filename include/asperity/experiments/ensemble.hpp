@@ -87,6 +87,21 @@ struct ImpactExperiment {
 /// stress suite), and more threads than any machine's cores only cost memory.
 inline constexpr int kMaxThreads = 1024;
 
+/// How a run keeps its per-drop values (report.json "statistics"): raw samples (exact KS, every
+/// figure; ~60 B per drop) or streaming histograms (experiments/streaming.hpp; memory independent of
+/// the number of drops, contact statistics only). automatic: streaming above kStreamingAutoDrops
+/// drops when no impact experiment runs, raw samples otherwise.
+enum class Statistics { automatic, raw, streaming };
+/// "auto", "raw", "streaming".
+std::string_view to_string(Statistics s);
+/// Throws std::invalid_argument naming the value.
+Statistics parse_statistics(std::string_view s);
+/// Above this many drops an automatic run streams (raw samples would take ~2 GiB).
+inline constexpr std::uint64_t kStreamingAutoDrops = std::uint64_t{1} << 25;
+/// Most drops of a streaming run (the counters are 64-bit; 2^50 is ~10^15). Beyond 2^31 drops only
+/// when statistics = streaming was asked for (validate).
+inline constexpr std::uint64_t kMaxStreamingDrops = std::uint64_t{1} << 50;
+
 struct EnsembleConfig {
   SphereParams sphere;
   Mode mode = Mode::explicit_spheres;
@@ -96,9 +111,14 @@ struct EnsembleConfig {
   Backend backend = Backend::grid;  ///< explicit design only
   int threads = 0;                  ///< 0 = OpenMP default, at most kMaxThreads
   ImpactExperiment impact;          ///< off: contact statistics only (nothing else is computed)
+  Statistics statistics = Statistics::automatic;
+  unsigned bins_log2 = 16;          ///< streaming: 2^bins_log2 fine bins per quantity, in [10, 24]
 
   friend bool operator==(const EnsembleConfig&, const EnsembleConfig&) = default;
 };
+
+/// Whether the run streams (Statistics): streaming, or automatic above kStreamingAutoDrops without impacts.
+bool uses_streaming(const EnsembleConfig& c);
 
 /// Throws std::invalid_argument naming the offending field.
 void validate(const EnsembleConfig& c);

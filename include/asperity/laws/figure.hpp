@@ -39,3 +39,17 @@ struct NamedFigure {
 };
 
 }  // namespace asperity
+
+namespace asperity {
+
+/// Measured points with a +-1 se band (e.g. a pooled cdf minus a law) against predicted curves,
+/// one panel.
+struct BandFigure {
+  std::string title, xlabel, ylabel;
+  std::string data_label;   ///< the ensemble the points come from, with n
+  double x_scale = 1.0, y_scale = 1.0;
+  std::vector<double> x, y, se;
+  std::vector<Curve> curves;
+};
+
+}  // namespace asperity

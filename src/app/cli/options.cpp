@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <map>
 #include <optional>
 #include <string>
@@ -132,7 +133,7 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
 // bad value is named as written.
 struct RawOptions {
   std::string preset_name = "fig3", asperities, radius, asperity_radius, drops, spheres, mode, backend, seed, out;
-  std::string threads, alpha;
+  std::string threads, alpha, statistics, bins_log2, checkpoint_every, resume;
   bool no_plots = false, quiet = false;
   std::string scene_file;
   std::string speed, omega_x, omega_y;
@@ -155,6 +156,16 @@ void add_options(CLI::App& app, RawOptions& r) {
   app.add_option("--seed", r.seed, "random seed (results are identical for any thread count)");
   app.add_option("--backend", r.backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
   app.add_option("--threads", r.threads, "OpenMP threads (0 = all)");
+  app.add_option("--statistics", r.statistics,
+                 "auto (default: streaming above 2^25 drops without impacts), raw (every drop kept: exact KS, figures "
+                 "of every quantity) or streaming (integer histograms, memory independent of the drops; contact only)");
+  app.add_option("--bins-log2", r.bins_log2, "streaming: 2^k fine bins per quantity, k in [10, 24] (default 16)");
+  app.add_option("--checkpoint-every", r.checkpoint_every,
+                 "streaming: seconds between checkpoints in --out (default 300; 0: only on SIGINT/SIGTERM)");
+  app.add_option("--resume", r.resume,
+                 "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only --threads, --quiet, "
+                 "--no-plots, --checkpoint-every may be given)")
+      ->excludes(preset_opt);
   app.add_option("--alpha", r.alpha, "significance level of each test, in (0,1)");
   app.add_option("--out", r.out, "output directory for report.json and figures");
   app.add_option("--speed", r.speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
@@ -268,7 +279,7 @@ void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, co
 void apply_design_options(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
   auto& e = scene.ensemble;
   if (given("--drops")) {
-    e.drops = parse_count("--drops", r.drops, 1, kMaxDrops);
+    e.drops = parse_count("--drops", r.drops, 1, kMaxStreamingDrops);  // > 2^31: streaming only (validate)
     if (k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
   }
   if (given("--mode")) apply_mode_option(scene, r, given, k);
@@ -421,6 +432,31 @@ void apply_tangential_option(Scene& scene, const RawOptions& r, const RunKind& k
   scene.bounce.eps_t = x.eps_t;
 }
 
+// --statistics, --bins-log2 (sphere contact runs), --checkpoint-every (streaming runs).
+void apply_streaming_options(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+  auto& e = scene.ensemble;
+  if (given("--checkpoint-every")) {
+    scene.checkpoint_seconds = parse_real("--checkpoint-every", r.checkpoint_every);
+    if (!(scene.checkpoint_seconds >= 0) || !std::isfinite(scene.checkpoint_seconds))
+      throw BadInput("--checkpoint-every: '" + r.checkpoint_every + "' must be a finite number of seconds >= 0");
+  }
+  if (given("--statistics")) e.statistics = parse_statistics(r.statistics);
+  if (given("--bins-log2")) e.bins_log2 = static_cast<unsigned>(parse_count("--bins-log2", r.bins_log2, 10, 24));
+  if ((given("--statistics") || given("--bins-log2")) && (k.bounce || k.mesh || k.radii))
+    refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
+}
+
+// --resume DIR: the checkpoint's own scene; only options that change no result may come with it.
+void check_resume_option(const RawOptions& r, const Given& given) {
+  for (const char* o : {"--scene", "--asperities", "--radius", "--asperity-radius", "--drops", "--mode", "--spheres",
+                        "--seed", "--backend", "--alpha", "--out", "--speed", "--omega-x", "--omega-y", "--variant",
+                        "--sequences", "--statistics", "--bins-log2", "--tangential"})
+    if (given(o))
+      throw BadInput(std::string(o) + ": --resume continues the checkpoint's own scene; only --threads, --quiet, "
+                                      "--no-plots and --checkpoint-every may be given with it");
+  if (r.resume.empty()) throw BadInput("--resume: '' is not a directory name");
+}
+
 // --threads, --alpha, --no-plots, --out; and the scene's name says when options changed the physics.
 void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
   if (given("--threads")) {
@@ -440,7 +476,7 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
     if (r.out.empty()) throw BadInput("--out: '' is not a directory name");
     scene.out = r.out;
   }
-  if (!given("--scene") && r.preset_name != scene.name) scene.name = r.preset_name;
+  if (!given("--scene") && !given("--resume") && r.preset_name != scene.name) scene.name = r.preset_name;
   if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
       given("--speed") || given("--omega-x") || given("--omega-y") || given("--tangential"))
     scene.name += "+custom";
@@ -449,7 +485,10 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
 // The preset or scene file, then the options over it (README "Scenes"), in this order: the kind of
 // run is taken after --asperity-radius, which can turn a radii run into the paper's.
 Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoader& load) {
-  Scene scene = !given("--scene") ? preset(r.preset_name) : load ? load(r.scene_file) : load_scene(r.scene_file);
+  if (given("--resume")) check_resume_option(r, given);
+  const std::string path = given("--resume") ? (std::filesystem::path(r.resume) / "checkpoint.toml").string() : r.scene_file;
+  Scene scene = !given("--scene") && !given("--resume") ? preset(r.preset_name) : load ? load(path) : load_scene(path);
+  if (given("--resume")) scene.out = r.resume, scene.resume = true;
   apply_body_options(scene, r, given);
   const RunKind k = run_kind(scene);
   apply_design_options(scene, r, given, k);
@@ -457,6 +496,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   if (given("--backend")) apply_backend_option(scene, r, k);
   apply_bounce_options(scene, r, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
+  apply_streaming_options(scene, r, given, k);
   apply_run_options(scene, r, given);
   validate(scene);
   return scene;

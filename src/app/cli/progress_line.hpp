@@ -32,19 +32,20 @@ class ProgressLine {
     const double now = clock_(), elapsed = now - start_;
     if (elapsed < quiet_for_) return;  // short runs stay quiet
     const int pct = static_cast<int>(100.0 * double(done) / double(total));
-    // The ETA extrapolates the rate so far (bounce runs: it includes the analyses of the variants
-    // done, so it is the remaining share of the whole run).
-    char eta[48] = "";
-    if (done > 0 && done < total)
-      std::snprintf(eta, sizeof eta, ", about %.0f s left", elapsed * double(total - done) / double(done));
+    // Rate and time to go (long streaming runs: hours); "-" before anything is done. Bounce runs:
+    // the rate includes the analyses of the variants done, so the ETA is the whole run's share.
+    const double rate = double(done) / elapsed;
+    char eta[64] = "-";
+    if (done > 0 && done < total) std::snprintf(eta, sizeof eta, "%.0f s", double(total - done) / rate);
+    else if (done >= total) std::snprintf(eta, sizeof eta, "0 s");
     if (tty_) {
       if (shown_ && now - last_ < 0.25 && done < total) return;
-      std::fprintf(out_, "\r  %s: %3d%% (%llu / %llu), %.1f s%s   ", unit_.c_str(), pct, (unsigned long long)done,
-                   (unsigned long long)total, elapsed, eta);
+      std::fprintf(out_, "\r  %s: %3d%% (%llu / %llu), %.1f s, %.3g %s/s, ETA %s  ", unit_.c_str(), pct,
+                   (unsigned long long)done, (unsigned long long)total, elapsed, rate, unit_.c_str(), eta);
       shown_ = true;
     } else if (pct >= next_pct_) {
-      std::fprintf(out_, "  %s: %d%% (%llu / %llu), %.1f s%s\n", unit_.c_str(), pct, (unsigned long long)done,
-                   (unsigned long long)total, elapsed, eta);
+      std::fprintf(out_, "  %s: %d%% (%llu / %llu), %.1f s, %.3g %s/s, ETA %s\n", unit_.c_str(), pct,
+                   (unsigned long long)done, (unsigned long long)total, elapsed, rate, unit_.c_str(), eta);
       next_pct_ = pct / 10 * 10 + 10;
     }
     last_ = now;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "asperity/app/checkpoint.hpp"
 #include "asperity/app/interrupt.hpp"
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
@@ -101,6 +102,7 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir) {
   staging->add(reports.at(0).filename().string());
   staging->commit();
   staging.reset();
+  if (uses_streaming(scene.ensemble)) remove_checkpoint(scene.out);  // this run's (or the run it continued)
   print_outcome(scene, r, reports);
   return r.rejected ? 1 : 0;
 }

@@ -1,0 +1,37 @@
+#pragma once
+// The report of a run on the streaming path (experiments/streaming.hpp): the same GeometryReport
+// as analyse() gives for raw samples, with tests evaluated on the binned data (laws/binned.hpp),
+// each row naming its statistic and resolution; report.json "statistics" says which path ran.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "asperity/app/plan.hpp"
+#include "asperity/app/report.hpp"
+#include "asperity/experiments/streaming.hpp"
+#include "asperity/laws/figure.hpp"
+
+namespace asperity {
+
+/// "streaming histogram, 2^k bins of u = F_ref(x) (...)".
+std::string streaming_label(const EnsembleConfig& c);
+
+/// Summaries and tests of a streamed run. Decisive rows: KS-sphere-bootstrap (every law, on the
+/// 2^10 coarse per-block cells) and, for r_xy, the likelihood ratio of Eq. 14 against the exact
+/// finite-N law (LR-block, se from the spread between blocks of spheres). binned-KS and chi2 on the
+/// 2^k fine bins assume iid drops: decisive for sampled runs, information for explicit ones.
+GeometryReport analyse_stream(const Scene& scene, const ContactStream& s);
+
+/// The finite-N figure: measured F^(r_xy) - F_Eq14(r_xy) with its +-1 se band (spread between
+/// blocks of spheres) against the predicted F_exact - F_Eq14.
+BandFigure finite_n_figure(const Scene& scene, const ContactStream& s);
+
+/// Writes `fig` as a PNG (gnuplot; atomic like write_histogram_png).
+void write_band_png(const std::filesystem::path& png, const BandFigure& fig);
+
+/// run_scene's streaming branch (uses_streaming): the stream, its analysis, the finite-N figure
+/// (finite_n.png in `dir`, default s.out, when plots are planned) and the plan with stage times.
+GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
+                                const StreamHooks& hooks = {}, const StreamState* resume = nullptr);
+
+}  // namespace asperity

@@ -1,0 +1,69 @@
+#pragma once
+// The streaming path of a contact ensemble (issue 14): the same drops as run_contact_ensemble (same
+// spheres, rotations and streams), but each drop's r_xy, r_x, r_y goes straight into integer
+// histograms and running moments (laws/binned.hpp); nothing per drop is kept, so memory does not
+// grow with the number of drops.
+//
+// Determinism: drops are cut into units of fixed drop-index ranges (one sphere's rotations
+// [j 4096, (j+1) 4096)); a unit's moments are accumulated in drop order by one thread and units are
+// merged in index order after each wave of units; counts are integers. So the statistics are the
+// same bits for any thread count and schedule, and a run resumed from a checkpoint (taken between
+// waves) ends with the same bits as one that was never interrupted.
+//
+// Blocks: the 2^coarse per-block histograms and moments group whole spheres (at most kStreamBlocks
+// groups of consecutive spheres; sampled runs: groups of consecutive drops), so the decisive tests
+// take their error from the spread between spheres.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "asperity/experiments/ensemble.hpp"
+#include "asperity/laws/binned.hpp"
+
+namespace asperity {
+
+inline constexpr std::size_t kStreamBlocks = 256;
+inline constexpr unsigned kStreamCoarseLog2 = 10;
+/// The streamed quantities, in this order.
+inline const std::vector<std::string> kStreamQuantities{"r_xy", "r_x", "r_y"};
+
+/// Everything a checkpoint holds: the statistics so far and where to continue.
+struct StreamState {
+  std::uint64_t next_unit = 0;  ///< units [0, next_unit) are done: 4096 rotations of one sphere (sampled: one drop)
+  std::vector<BinnedStats> stats;     ///< one per kStreamQuantities
+  std::uint64_t core_contacts = 0;
+  std::uint64_t check_queries = 0, check_agreed = 0;
+  std::uint64_t index_bytes = 0;      ///< largest spatial index built so far
+  friend bool operator==(const StreamState&, const StreamState&) = default;
+};
+
+/// The empty state of a run: references Eq. 14's Rayleigh (r_xy) and Eq. 18's normal (r_x, r_y)
+/// with sigma^2 = 1 / (2 pi lambda); 2^c.bins_log2 fine bins.
+StreamState initial_stream_state(const EnsembleConfig& c);
+
+/// Between waves (every ~10^5..10^6 drops) the driver asks stop(): true ends the run with
+/// complete = false after a checkpoint; checkpoint_due(): true writes one and goes on.
+struct StreamHooks {
+  std::function<bool()> stop;
+  std::function<bool()> checkpoint_due;
+  std::function<void(const StreamState&)> checkpoint;
+};
+
+struct ContactStream {
+  StreamState state;
+  bool complete = false;
+  std::uint64_t spheres = 0, rotations = 0;  ///< K and M (sampled: drops and 1)
+  double seconds_generate = 0, seconds_index = 0, seconds_query = 0;
+  std::size_t index_bytes = 0;  ///< largest index of the whole run (resumed runs included)
+  CrossCheck cross_check;
+  std::size_t memory_bytes = 0;  ///< of the statistics (all threads' histograms), independent of the drops
+};
+
+/// Runs (or continues from `resume`, a state of the same config) the ensemble of `c` on the
+/// streaming path. Throws std::invalid_argument for an invalid config (validate) or an impact
+/// experiment, std::runtime_error when the cross-check disagrees (as run_contact_ensemble).
+ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progress = {}, const StreamHooks& hooks = {},
+                                 const StreamState* resume = nullptr);
+
+}  // namespace asperity

@@ -1,0 +1,313 @@
+#include "asperity/app/stream_report.hpp"
+
+#include <boost/math/distributions/binomial.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <iostream>
+#include <locale>
+#include <optional>
+#include <numbers>
+#include <sstream>
+
+#include "asperity/app/checkpoint.hpp"
+#include "asperity/app/interrupt.hpp"
+#include "asperity/app/plot.hpp"
+#include "asperity/app/scene_file.hpp"
+#include "asperity/laws/binned.hpp"
+#include "asperity/laws/block_ks.hpp"
+#include "asperity/laws/theory.hpp"
+
+namespace asperity {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string fmt(double v, int prec = 3) {
+  std::ostringstream os;
+  os << std::setprecision(prec) << v;
+  return os.str();
+}
+
+// Mean with the se of a ratio estimator over blocks; quantiles from the fine histogram, interpolated
+// linearly in u within a bin (se not estimated: NaN).
+Summary summarize_binned(const BinnedStats& b, std::span<const double> probs) {
+  Summary s;
+  const Moments m = b.moments();
+  s.n = m.n;
+  s.mean.value = m.mean;
+  s.std.value = std::sqrt(m.variance());
+  s.std.se = kNaN;
+  double ss = 0;
+  std::size_t used = 0;
+  for (const auto& g : b.block_moments)
+    if (g.n) ss += std::pow(double(g.n) * (g.mean - m.mean), 2), ++used;
+  s.mean.se = used > 1 ? std::sqrt(double(used) / double(used - 1) * ss) / double(m.n) : kNaN;
+  s.batches = used;
+  s.probs.assign(probs.begin(), probs.end());
+  const double B = double(b.fine_bins());
+  for (double p : probs) {
+    const double target = p * double(m.n);
+    double cum = 0;
+    std::size_t j = 0;
+    while (j + 1 < b.fine.size() && cum + double(b.fine[j]) < target) cum += double(b.fine[j++]);
+    const double frac = b.fine[j] ? (target - cum) / double(b.fine[j]) : 0.5;
+    s.quantiles.push_back({b.ref.quantile((double(j) + std::clamp(frac, 0.0, 1.0)) / B), kNaN});
+  }
+  return s;
+}
+
+struct StreamLaws {
+  std::string quantity;
+  std::vector<Law> laws;
+};
+
+std::vector<StreamLaws> stream_laws(const EnsembleConfig& e) {
+  const auto n = e.sphere.asperities;
+  const double R = e.sphere.radius;
+  const Law rx = exact_sphere_rx(n, R);
+  return {{"r_xy", {eq14_rxy(n, R), exact_sphere_rxy(n, R)}}, {"r_x", {eq18_rx(n, R), rx}}, {"r_y", {eq18_rx(n, R), rx}}};
+}
+
+// A report row by named fields (the common part first, laws/verdict.hpp LawTest).
+TestReport test_row(const std::string& quantity, const std::string& law, const std::string& statistic, double D, double p,
+                    std::uint64_t n, double predicted_mean, bool iid, bool decisive, Verdict verdict, std::string note) {
+  TestReport r;
+  r.quantity = quantity, r.law = law, r.decisive = decisive, r.verdict = verdict, r.note = std::move(note);
+  r.statistic = statistic, r.D = D, r.p = p, r.n = n, r.predicted_mean = predicted_mean, r.iid = iid;
+  return r;
+}
+
+TestReport row(const std::string& q, const Law& law, const BinnedTest& t, bool iid, bool decisive, double alpha) {
+  TestReport r = test_row(q, law.name, t.statistic, t.statistic == "LR-block" ? kNaN : t.value, t.p, t.n, law.mean, iid,
+                          decisive, std::isnan(t.p) ? Verdict::skipped : verdict_at(t.p, alpha), t.note);
+  if (t.statistic == "LR-block") r.note = "z = " + fmt(t.value, 4) + "; " + r.note;
+  if (!decisive) r.note += "; information only: the drops of one sphere are not iid";
+  return r;
+}
+
+void design_and_note(GeometryReport& r, const Scene& scene, const ContactStream& s) {
+  const auto& e = scene.ensemble;
+  const bool expl = e.mode == Mode::explicit_spheres;
+  auto& d = r.design;
+  d.kind = expl ? "explicit" : "sampled";
+  d.spheres = s.spheres, d.rotations_per_sphere = s.rotations;
+  d.backend = expl ? std::string(to_string(e.backend)) : std::string("none");
+  const DesignScales sc = design_scales(e.mode, e.sphere.asperities, s.spheres, r.samples);
+  d.statistical_scale = sc.statistical, d.quenched_scale = sc.quenched;
+  d.model_error_scale = model_error_scale(e.sphere.asperities, e.sphere.radius);
+  std::ostringstream note;
+  if (expl)
+    note << "explicit geometry: " << s.spheres << " sphere(s) of " << e.sphere.asperities << " asperities x "
+         << s.rotations << " Haar-random rotations each; every contact found by a " << to_string(e.backend)
+         << " spatial query. ";
+  else
+    note << "sampled from the exact finite-N law of the lowest asperity -- no geometry; drops are iid. ";
+  note << "Statistics: " << r.statistics << "; no drop is kept (memory independent of the drops). Decisive tests: KS of all drops on 2^" << kStreamCoarseLog2
+       << " cells with a sphere-block bootstrap p, and for r_xy the likelihood ratio of Eq. 14 against the exact "
+          "finite-N law with its se from the spread between "
+       << s.state.stats[0].blocks << " blocks of whole " << (expl ? "spheres" : "drops") << ".";
+  r.ensemble_note = note.str();
+}
+
+}  // namespace
+
+std::string streaming_label(const EnsembleConfig& c) {
+  return "streaming histogram, 2^" + std::to_string(c.bins_log2) +
+         " bins of u = F_ref(x) per quantity (F_ref: Eq. 14 for r_xy, Eq. 18 for r_x, r_y) and 2^" +
+         std::to_string(kStreamCoarseLog2) + " cells per block of spheres";
+}
+
+GeometryReport analyse_stream(const Scene& scene, const ContactStream& s) {
+  GeometryReport r;
+  r.scene = scene;
+  const auto& e = scene.ensemble;
+  const auto& sp = e.sphere;
+  const bool expl = e.mode == Mode::explicit_spheres;
+  r.samples = s.state.stats[0].n();
+  r.statistics = streaming_label(e);
+  r.core_contacts = s.state.core_contacts;
+  r.core_probability = core_contact_probability(sp.asperities, sp.radius, sp.asperity_radius);
+  r.core_probability_paper = core_contact_probability_paper(sp.asperities, sp.radius, sp.asperity_radius);
+  r.gap_min = r.gap_median = kNaN;  // not streamed
+  r.index_bytes = s.index_bytes;
+  r.cross_check = s.cross_check;
+  if (expl) r.quenched_scale = quenched_deviation_scale(sp.asperities);
+  design_and_note(r, scene, s);
+  const bool decisive_design = !expl || s.spheres >= kMinDecisiveSpheres;
+  const std::vector<double> probs{0.01, 0.05, 0.25, 0.5, 0.75, 0.95, 0.99};
+  const auto sets = stream_laws(e);
+  for (std::size_t qi = 0; qi < sets.size(); ++qi) {
+    const BinnedStats& b = s.state.stats[qi];
+    const auto& set = sets[qi];
+    r.quantities.push_back({set.quantity, summarize_binned(b, probs)});
+    std::vector<Cdf> cdfs;
+    for (const auto& l : set.laws) cdfs.push_back(l.cdf);
+    const auto boot = block_ks_tests(to_block_bins(b), cdfs, scene.alpha, e.seed, qi);
+    for (std::size_t li = 0; li < set.laws.size(); ++li) {
+      const Law& law = set.laws[li];
+      r.tests.push_back(test_row(set.quantity, law.name, "KS-sphere-bootstrap", boot[li].D, boot[li].p, r.samples, law.mean,
+                                 false, decisive_design, decisive_design ? boot[li].verdict : Verdict::not_decisive,
+                                 "B = " + std::to_string(boot[li].replicates) + " block bootstrap replicates over " +
+                                     std::to_string(b.blocks) + " blocks; 2^" + std::to_string(kStreamCoarseLog2) +
+                                     " cells of u, resolution 2^-" + std::to_string(kStreamCoarseLog2)));
+      r.tests.push_back(row(set.quantity, law, binned_ks(b, law.cdf), !expl, !expl, scene.alpha));
+      r.tests.push_back(row(set.quantity, law, binned_chi2(b, law.cdf), !expl, !expl, scene.alpha));
+    }
+    if (set.quantity == "r_xy" && b.blocks >= 2) {
+      const LrTest lr = binned_lr(b, set.laws[0].cdf, set.laws[1].cdf);
+      const std::string kl = "; L = " + fmt(lr.L, 4) + " +- " + fmt(lr.se, 2) + " per drop, KL(eq14||exact) = " +
+                             fmt(lr.kl01, 4) + ", KL(exact||eq14) = " + fmt(lr.kl10, 4);
+      r.tests.push_back(row(set.quantity, set.laws[0], lr.law0, false, decisive_design, scene.alpha));
+      r.tests.back().note += kl;
+      r.tests.push_back(row(set.quantity, set.laws[1], lr.law1, false, decisive_design, scene.alpha));
+      r.tests.back().note += kl;
+    }
+  }
+  TestReport core = test_row("core_contacts", "exact-sphere", "binomial", kNaN, 1, r.samples,
+                             r.core_probability * double(r.samples), !expl, !expl, Verdict::accept, "");
+  boost::math::binomial_distribution<double> bin(double(r.samples), r.core_probability);
+  const double k = double(r.core_contacts);
+  core.p = std::min(1.0, 2.0 * std::min(boost::math::cdf(bin, k),
+                                        k > 0 ? boost::math::cdf(boost::math::complement(bin, k - 1)) : 1.0));
+  core.verdict = verdict_at(core.p, scene.alpha);
+  core.note = "central sphere touched first";
+  if (expl) core.note += "; iid binomial p-value, the spread between spheres is not accounted for: information only";
+  r.tests.push_back(core);
+  r.timings_s = {{"generate", s.seconds_generate}, {"index", s.seconds_index}, {"query", s.seconds_query}};
+  return r;
+}
+
+BandFigure finite_n_figure(const Scene& scene, const ContactStream& s) {
+  const auto& sp = scene.ensemble.sphere;
+  const Law eq14 = eq14_rxy(sp.asperities, sp.radius), exact = exact_sphere_rxy(sp.asperities, sp.radius);
+  const CdfBand band = pooled_cdf(s.state.stats[0]);
+  BandFigure f;
+  f.title = "finite-N correction of Eq. (14): N = " + std::to_string(sp.asperities);
+  f.xlabel = "r_{xy} [{/Symbol m}m]";
+  f.ylabel = "F(r_{xy}) - F_{Eq. 14}(r_{xy})";
+  f.x_scale = 1e6;
+  const bool expl = scene.ensemble.mode == Mode::explicit_spheres;
+  f.data_label = (expl ? "explicit geometry: " + std::to_string(s.spheres) + " spheres x " + std::to_string(s.rotations) +
+                             " rotations"
+                       : std::string("sampled from the exact law, no geometry")) +
+                 ", +-1 se between blocks (n = " + std::to_string(s.state.stats[0].n()) + ")";
+  // Every 16th coarse edge in the bulk (the tails carry nothing at this scale).
+  for (std::size_t j = 15; j < band.x.size(); j += 16) {
+    if (band.x[j] > 4 * s.state.stats[0].ref.sigma) break;
+    f.x.push_back(band.x[j]);
+    f.y.push_back(band.cdf[j] - eq14.cdf(band.x[j]));
+    f.se.push_back(band.se[j]);
+  }
+  const double hi = 4 * s.state.stats[0].ref.sigma;
+  f.curves.push_back(sampled_curve([&](double x) { return exact.cdf(x) - eq14.cdf(x); },
+                                   "predicted: exact finite-N law - Eq. (14)", 0, hi, 300));
+  f.curves.push_back(sampled_curve([](double) { return 0.0; }, "Eq. (14)", 0, hi, 2));
+  return f;
+}
+
+void write_band_png(const std::filesystem::path& png, const BandFigure& fig) {
+  write_gnuplot_png(png, [&](const std::filesystem::path& out) {
+    std::ostringstream s;
+    s.imbue(std::locale::classic());
+    s << std::setprecision(12) << "$pts << EOD\n";
+    for (std::size_t i = 0; i < fig.x.size(); ++i)
+      s << fig.x[i] * fig.x_scale << ' ' << fig.y[i] * fig.y_scale << ' ' << fig.se[i] * fig.y_scale << '\n';
+    s << "EOD\n";
+    for (std::size_t k = 0; k < fig.curves.size(); ++k) {
+      s << "$c" << k << " << EOD\n";
+      for (std::size_t i = 0; i < fig.curves[k].x.size(); ++i)
+        s << fig.curves[k].x[i] * fig.x_scale << ' ' << fig.curves[k].y[i] * fig.y_scale << '\n';
+      s << "EOD\n";
+    }
+    auto text = [](const std::string& t) {
+      std::string o = "\"";
+      for (char c : t) o += c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c);
+      return o + "\"";
+    };
+    std::string path = "'";
+    for (char c : out.string()) path += c == '\'' ? std::string("''") : std::string(1, c);
+    s << "set encoding utf8\nset terminal pngcairo size 900,720 enhanced font 'sans,12'\nset output " << path << "'\n"
+      << "set title " << text(fig.title) << "\nset xlabel " << text(fig.xlabel) << "\nset ylabel " << text(fig.ylabel)
+      << "\nset key below Left reverse\nset grid\nplot $pts using 1:2:3 with yerrorbars pt 7 ps 0.6 lc rgb '#1f4e9c' title "
+      << text(fig.data_label);
+    const char* colours[] = {"#c0392b", "#555555"};
+    for (std::size_t k = 0; k < fig.curves.size(); ++k)
+      s << ", $c" << k << " with lines lw 2 lc rgb '" << colours[k % 2] << "' title " << text(fig.curves[k].label);
+    s << "\n";
+    return s.str();
+  });
+}
+
+namespace {
+
+// The stream of `run` (the planned ensemble of scene s) with checkpoints in s.out (not the staging
+// directory: a checkpoint outlives an interrupted run): every s.checkpoint_seconds, and when a
+// signal arrives (validate-geometry: the signal waits for the end of a wave, the checkpoint is
+// written, then the signal ends the process as usual, exit 128 + signal).
+ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run, const Progress& progress,
+                                      const StreamHooks& given, const StreamState* resume) {
+  StreamState resumed;
+  if (!resume && s.resume) resumed = read_checkpoint(s.out, s), resume = &resumed;
+  using Clock = std::chrono::steady_clock;
+  auto last = Clock::now();
+  StreamHooks h = given;
+  if (!h.stop) h.stop = [] { return interrupt_pending() != 0; };
+  if (!h.checkpoint_due && s.checkpoint_seconds > 0)
+    h.checkpoint_due = [&] { return std::chrono::duration<double>(Clock::now() - last).count() >= s.checkpoint_seconds; };
+  if (!h.checkpoint)
+    h.checkpoint = [&](const StreamState& st) {
+      write_checkpoint(s.out, s, st);
+      last = Clock::now();
+    };
+  std::optional<InterruptDeferral> defer;
+  if (interrupt_cleanup_installed()) defer.emplace();
+  ContactStream cs = run_contact_stream(run, progress, h, resume);
+  if (!cs.complete) {
+    std::cerr << "\nvalidate-geometry: stopped after " << cs.state.stats[0].n() << " of " << run.drops
+              << " drops; checkpoint in " << (s.out / kCheckpointState).string()
+              << ": continue with validate-geometry --resume " << s.out.string() << "\n";
+    defer.reset();  // a pending signal ends the process here
+    throw std::runtime_error("the streaming run stopped before its last drop; checkpoint in " +
+                             (s.out / kCheckpointState).string());
+  }
+  return cs;
+}
+
+}  // namespace
+
+GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
+                                const StreamHooks& hooks, const StreamState* resume) {
+  const Scene& run = plan.scene;
+  const ContactStream cs = stream_with_checkpoints(s, run.ensemble, progress, hooks, resume);
+  auto t0 = std::chrono::steady_clock::now();
+  auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
+  GeometryReport r = analyse_stream(run, cs);
+  r.timings_s.emplace_back("analysis", since(t0));
+  plan.stage("analysis").seconds = r.timings_s.back().second;
+  plan.stage("analysis").reason = "contact laws of r_xy, r_x, r_y on the streamed histograms (" + streaming_label(run.ensemble) + ")";
+  if (plan.runs("plots")) {
+    plan.stage("plots").reason = "outputs.plots: streaming keeps no drops, so one figure: finite_n.png (measured F - F_Eq14 "
+                                 "of r_xy with its band between blocks, against the exact finite-N law)";
+    if (plotting_available()) {
+      t0 = std::chrono::steady_clock::now();
+      write_band_png((dir.empty() ? run.out : dir) / "finite_n.png", finite_n_figure(run, cs));
+      r.plots.push_back("finite_n.png");
+      r.timings_s.emplace_back("plots", since(t0));
+      plan.stage("plots").seconds = r.timings_s.back().second;
+    }
+  }
+  plan.stage("generate").seconds = cs.seconds_generate;
+  plan.stage("index").seconds = cs.seconds_index;
+  plan.stage("query").seconds = cs.seconds_query;
+  r.plan = std::move(plan.stages);
+  r.scene_toml = to_toml(s);
+  return r;
+}
+
+}  // namespace asperity

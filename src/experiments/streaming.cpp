@@ -1,0 +1,259 @@
+#include "asperity/experiments/streaming.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <stdexcept>
+
+#include "asperity/core/orientation.hpp"
+#include "asperity/core/random.hpp"
+#include "asperity/laws/theory.hpp"
+#include "experiments/ensemble_detail.hpp"
+
+namespace asperity {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+constexpr std::uint64_t kUnit = 4096;         // rotations per unit (moments merged per unit, in order)
+constexpr std::uint64_t kWaveUnits = 16384;   // units per wave (merge, progress, stop, checkpoint between waves)
+constexpr std::uint64_t kBigSphereUnits = 16; // spheres of >= 16 units run their units in parallel
+constexpr std::uint64_t kWaveDrops = 1 << 18; // small spheres: at most this many drops per wave (or one sphere)
+constexpr std::size_t kQ = 3;                 // r_xy, r_x, r_y
+
+struct Slot {
+  Moments m[kQ];
+  std::uint64_t core = 0;
+};
+
+// What the threads of a wave write into: coarse counts atomically (integers: any order), fine
+// counts into their own histograms (folded into the state between waves), moments into their slot.
+struct Sink {
+  std::vector<BinnedStats>& stats;
+  std::vector<std::vector<std::uint64_t>> fine;  // thread t, quantity q at t * kQ + q
+  std::uint64_t K = 0, G = 0;
+  std::size_t block(std::uint64_t k) const { return static_cast<std::size_t>(k * G / K); }
+
+  void count(int t, std::size_t g, const Contact& ct, Slot& slot) {
+    const double x[kQ] = {ct.r_xy, ct.r.x(), ct.r.y()};
+    for (std::size_t q = 0; q < kQ; ++q) {
+      BinnedStats& s = stats[q];
+      const std::size_t f = s.fine_bin(s.ref.cdf(x[q]));
+      ++fine[static_cast<std::size_t>(t) * kQ + q][f];
+      std::atomic_ref<std::uint64_t>(s.coarse[g * s.coarse_bins() + (f >> (s.fine_log2 - s.coarse_log2))])
+          .fetch_add(1, std::memory_order_relaxed);
+      slot.m[q].add(x[q]);
+    }
+    slot.core += ct.core ? 1 : 0;
+  }
+  void fold() {
+    for (std::size_t i = 0; i < fine.size(); ++i) {
+      auto& dst = stats[i % kQ].fine;
+      for (std::size_t b = 0; b < dst.size(); ++b) dst[b] += fine[i][b];
+      std::fill(fine[i].begin(), fine[i].end(), 0);
+    }
+  }
+};
+
+// One explicit sphere, built and indexed (timed by the caller).
+struct Built {
+  RoughSphere body;
+  std::unique_ptr<ContactQuery> index;
+};
+
+struct Driver {
+  const EnsembleConfig& c;
+  Sink& sink;
+  detail::CheckPlan plan;
+  std::uint64_t K, m, units_per_sphere;
+  double gen = 0, idx = 0;
+  std::size_t bytes = 0;
+
+  Built build(std::uint64_t k, double& g, double& i) const {
+    auto t = Clock::now();
+    Built b{make_rough_sphere(c.sphere, c.seed, k), nullptr};
+    g += since(t);
+    t = Clock::now();
+    b.index = make_contact_query(c.backend, b.body.centres);
+    i += since(t);
+    return b;
+  }
+
+  // Rotations [j kUnit, ...) of sphere k: the same streams as run_contact_ensemble's.
+  void explicit_unit(const Built& b, std::uint64_t k, std::uint64_t j, int t, Slot& slot) const {
+    const std::uint64_t lo = j * kUnit, hi = std::min(m, lo + kUnit);
+    std::vector<Rotation> q(hi - lo);
+    std::vector<Vec3> d(hi - lo);
+    std::vector<Nearest> nn(hi - lo);
+    for (std::uint64_t r = lo; r < hi; ++r) {
+      Stream st(c.seed, Purpose::orientation, k * m + r);
+      q[r - lo] = random_rotation(st);
+      d[r - lo] = body_down(q[r - lo]);
+    }
+    b.index->lowest(d, nn);
+    const std::size_t g = sink.block(k);
+    for (std::uint64_t r = lo; r < hi; ++r) {
+      const Nearest& a = nn[r - lo];
+      sink.count(t, g, make_contact(a, b.body.centres[a.index], q[r - lo], c.sphere.radius, c.sphere.asperity_radius),
+                 slot);
+    }
+  }
+
+  // Sampled: "sphere" k is drop k, from the exact law of the lowest asperities (no geometry).
+  void sampled_unit(std::uint64_t k, int t, Slot& slot) const {
+    const auto cap = fresh_cap(c.sphere.asperities, k, c.seed);
+    const Nearest nn = brute_lowest(cap, Vec3(0, 0, -1));
+    sink.count(t, sink.block(k),
+               make_contact(nn, cap[nn.index], Rotation::Identity(), c.sphere.radius, c.sphere.asperity_radius), slot);
+  }
+
+  // The run's queries of a checked sphere (rotations j % stride == 0, the first per_sphere), asked
+  // again of its index (deterministic: the answers the run uses) and of the other backends.
+  detail::SphereCheck check(const Built& b, std::uint64_t k) const {
+    std::vector<std::pair<Vec3, Nearest>> answers;
+    for (std::uint64_t r = 0; r < m && answers.size() < plan.per_sphere; r += plan.stride) {
+      Stream st(c.seed, Purpose::orientation, k * m + r);
+      const Vec3 d = body_down(random_rotation(st));
+      answers.emplace_back(d, b.index->lowest(d));
+    }
+    return detail::cross_check_sphere(c, b.body.centres, answers, plan.others, k);
+  }
+};
+
+void merge_slots(StreamState& st, const Sink& sink, const std::vector<Slot>& slots, std::uint64_t first_unit,
+                 std::uint64_t units_per_sphere) {
+  for (std::size_t i = 0; i < slots.size(); ++i) {
+    const std::size_t g = sink.block((first_unit + i) / units_per_sphere);
+    for (std::size_t q = 0; q < kQ; ++q) st.stats[q].block_moments[g].merge(slots[i].m[q]);
+    st.core_contacts += slots[i].core;
+  }
+}
+
+void add_check(StreamState& st, const detail::SphereCheck& ch, std::string& first_error) {
+  st.check_queries += ch.queries, st.check_agreed += ch.agreed;
+  if (first_error.empty()) first_error = ch.first_disagreement;
+}
+
+// Whole spheres [u0 / us, u1 / us) in parallel, each on one thread: build, check, its units in order.
+void small_sphere_wave(Driver& dr, StreamState& st, std::uint64_t u0, std::uint64_t u1, std::vector<Slot>& slots,
+                       std::string& error) {
+  const std::uint64_t us = dr.units_per_sphere, k0 = u0 / us, k1 = u1 / us;
+  const bool sampled = dr.c.mode == Mode::sampled;
+  double gen = 0, idx = 0;
+  std::size_t bytes = 0;
+  std::vector<detail::SphereCheck> checks(k1 - k0);
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : gen, idx) reduction(max : bytes)
+  for (std::int64_t kk = std::int64_t(k0); kk < std::int64_t(k1); ++kk) {
+    const auto k = static_cast<std::uint64_t>(kk);
+    const int t = omp_get_thread_num();
+    if (sampled) {
+      dr.sampled_unit(k, t, slots[k - k0]);
+      continue;
+    }
+    const Built b = dr.build(k, gen, idx);
+    bytes = std::max(bytes, b.index->memory_bytes());
+    if (dr.plan.checked(k)) checks[k - k0] = dr.check(b, k);
+    for (std::uint64_t j = 0; j < us; ++j) dr.explicit_unit(b, k, j, t, slots[(k - k0) * us + j]);
+  }
+  dr.gen += gen, dr.idx += idx, dr.bytes = std::max(dr.bytes, bytes);
+  for (const auto& ch : checks) add_check(st, ch, error);
+}
+
+// Units [u0, u1) of one big sphere in parallel (the sphere is built once, kept across waves).
+void big_sphere_wave(Driver& dr, StreamState& st, std::uint64_t u0, std::uint64_t u1, std::vector<Slot>& slots,
+                     std::unique_ptr<Built>& current, std::uint64_t& current_k, std::string& error) {
+  const std::uint64_t us = dr.units_per_sphere, k = u0 / us;
+  if (!current || current_k != k) {
+    current = std::make_unique<Built>(dr.build(k, dr.gen, dr.idx));
+    current_k = k;
+    dr.bytes = std::max(dr.bytes, current->index->memory_bytes());
+    // Checked once per sphere, at its first unit (a resumed run past it has its counts already).
+    if (u0 % us == 0 && dr.plan.checked(k)) add_check(st, dr.check(*current, k), error);
+  }
+  const Built& b = *current;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t u = std::int64_t(u0); u < std::int64_t(u1); ++u)
+    dr.explicit_unit(b, k, std::uint64_t(u) % us, omp_get_thread_num(), slots[std::uint64_t(u) - u0]);
+}
+
+}  // namespace
+
+StreamState initial_stream_state(const EnsembleConfig& c) {
+  const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * areal_density(c.sphere.asperities, c.sphere.radius));
+  const std::uint64_t K = c.mode == Mode::sampled ? c.drops : c.spheres;
+  const std::size_t G = static_cast<std::size_t>(std::min<std::uint64_t>(K, kStreamBlocks));
+  StreamState s;
+  s.stats.push_back(make_binned({Reference::Kind::rayleigh, sigma}, G, c.bins_log2, kStreamCoarseLog2));
+  for (int i = 0; i < 2; ++i)
+    s.stats.push_back(make_binned({Reference::Kind::normal, sigma}, G, c.bins_log2, kStreamCoarseLog2));
+  return s;
+}
+
+ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progress, const StreamHooks& hooks,
+                                 const StreamState* resume) {
+  validate(c);
+  if (c.impact.enabled) throw std::invalid_argument("streaming statistics: contact statistics only (no impact experiment)");
+  if (c.threads > 0) omp_set_num_threads(c.threads);
+  ContactStream out;
+  out.state = resume ? *resume : initial_stream_state(c);
+  if (resume && !(initial_stream_state(c).stats.size() == resume->stats.size() &&
+                  resume->stats[0].blocks == initial_stream_state(c).stats[0].blocks &&
+                  resume->stats[0].fine_log2 == c.bins_log2))
+    throw std::invalid_argument("resume: the checkpoint's statistics do not match this run's configuration");
+  StreamState& st = out.state;
+  const bool sampled = c.mode == Mode::sampled;
+  const std::uint64_t K = sampled ? c.drops : c.spheres, m = sampled ? 1 : c.drops / c.spheres;
+  const std::uint64_t us = (m + kUnit - 1) / kUnit, total_units = K * us;
+  out.spheres = K, out.rotations = m;
+  Sink sink{st.stats, {}, K, st.stats[0].blocks};
+  sink.fine.assign(std::size_t(omp_get_max_threads()) * kQ, std::vector<std::uint64_t>(st.stats[0].fine_bins(), 0));
+  Driver dr{c, sink, sampled ? detail::CheckPlan{} : detail::check_plan(c), K, m, us};
+  for (Backend b : dr.plan.others) out.cross_check.backends.emplace_back(to_string(b));
+  const bool big = !sampled && us >= kBigSphereUnits;
+  std::unique_ptr<Built> current;
+  std::uint64_t current_k = 0;
+  std::string error;
+  std::vector<Slot> slots;
+  const auto t0 = Clock::now();
+  std::uint64_t u = st.next_unit;  // in units (sampled: drops)
+  while (u < total_units) {
+    // A wave: up to kWaveUnits units; whole spheres unless the spheres are big.
+    const std::uint64_t u1 = big ? std::min({total_units, u + kWaveUnits, (u / us + 1) * us})
+                                 : std::min(total_units, u + std::max<std::uint64_t>(1, std::min(kWaveUnits / us, kWaveDrops / m)) * us);
+    slots.assign(u1 - u, Slot{});
+    if (big) big_sphere_wave(dr, st, u, u1, slots, current, current_k, error);
+    else small_sphere_wave(dr, st, u, u1, slots, error);
+    if (!error.empty())
+      throw std::runtime_error("cross-check failed: " + std::to_string(st.check_queries - st.check_agreed) + " of " +
+                               std::to_string(st.check_queries) +
+                               " re-answered queries disagree with the run's backend; first: " + error);
+    merge_slots(st, sink, slots, u, us);
+    st.index_bytes = std::max<std::uint64_t>(st.index_bytes, dr.bytes);
+    u = st.next_unit = u1;
+    if (progress) progress(std::min(c.drops, (u / us) * m + (u % us) * kUnit), c.drops);
+    const bool stop = u < total_units && hooks.stop && hooks.stop();
+    if (stop || (u < total_units && hooks.checkpoint_due && hooks.checkpoint_due())) {
+      sink.fold();
+      if (hooks.checkpoint) hooks.checkpoint(st);
+    }
+    if (stop) break;
+  }
+  sink.fold();
+  out.complete = st.next_unit >= total_units;
+  out.seconds_generate = dr.gen, out.seconds_index = dr.idx, out.seconds_query = since(t0);
+  st.index_bytes = std::max<std::uint64_t>(st.index_bytes, dr.bytes);
+  out.index_bytes = static_cast<std::size_t>(st.index_bytes);
+  out.cross_check.queries = st.check_queries, out.cross_check.agreed = st.check_agreed;
+  for (const auto& s : st.stats)
+    out.memory_bytes += (s.fine.size() * (1 + std::size_t(omp_get_max_threads())) + s.coarse.size()) * 8;
+  return out;
+}
+
+}  // namespace asperity

@@ -1,0 +1,191 @@
+// Long streaming runs survive (issue 14, item 4): SIGTERM ends a run with a checkpoint, `--resume
+// DIR` continues it to a report identical to the uninterrupted run's (timings aside), a checkpoint
+// is never overwritten by a new run, and a damaged or foreign checkpoint is refused.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "asperity/app/scene.hpp"
+#include "asperity/app/scene_file.hpp"
+#include "run_command.hpp"
+
+namespace fs = std::filesystem;
+using asperity::testing::run_command;
+
+namespace {
+
+std::string vg() { return VALIDATE_GEOMETRY; }
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("asperity-checkpoint-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+std::string slurp(const fs::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// validate-geometry with default signal dispositions, output into `log`.
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);
+    if (!std::freopen(log.c_str(), "w", stdout) || !std::freopen(log.c_str(), "a", stderr)) ::_exit(99);
+    std::vector<char*> argv;
+    std::string prog = vg();
+    argv.push_back(prog.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(98);
+  }
+  return pid;
+}
+
+int wait_status(pid_t pid) {
+  int st = 0;
+  ::waitpid(pid, &st, 0);
+  return WIFEXITED(st) ? WEXITSTATUS(st) : 1000 + WTERMSIG(st);
+}
+
+// The report without what may differ between an interrupted-and-resumed run and a whole one.
+nlohmann::json comparable(const fs::path& report) {
+  auto j = nlohmann::json::parse(slurp(report));
+  for (const char* k : {"timings_s", "plan", "scene_file"}) j.erase(k);
+  return j;
+}
+
+// 10^6 explicit drops at N = 10^3 (2500 spheres x 400 rotations): 4 waves of streaming statistics.
+std::vector<std::string> run_args(const fs::path& out) {
+  return {"-q", "--asperities", "1000", "--drops", "1000000", "--spheres", "2500", "--statistics", "streaming",
+          "--no-plots", "--out", out.string()};
+}
+
+}  // namespace
+
+TEST(Checkpoint, SigtermThenResumeEqualsTheUninterruptedRun) {
+  const fs::path whole = fresh_dir("whole"), cut = fresh_dir("cut");
+  const fs::path log = cut.string() + ".log";
+  auto args = run_args(whole);
+  const int whole_status = wait_status(spawn(args, log));
+  ASSERT_TRUE(whole_status == 0 || whole_status == 1) << slurp(log);
+  ASSERT_FALSE(fs::exists(whole / "checkpoint.bin")) << "a completed run leaves no checkpoint";
+
+  // A checkpoint after every wave; SIGTERM once the first one is there.
+  args = run_args(cut);
+  args.insert(args.end(), {"--checkpoint-every", "0.000001", "--threads", "2"});
+  const pid_t pid = spawn(args, log);
+  for (int i = 0; i < 6000 && !fs::exists(cut / "checkpoint.bin"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(fs::exists(cut / "checkpoint.bin")) << slurp(log);
+  ::kill(pid, SIGTERM);
+  const int status = wait_status(pid);
+  ASSERT_EQ(status, 128 + SIGTERM) << "the run ended before the signal? " << slurp(log);
+  EXPECT_NE(slurp(log).find("--resume " + cut.string()), std::string::npos) << slurp(log);
+  EXPECT_TRUE(fs::exists(cut / "checkpoint.bin") && fs::exists(cut / "checkpoint.toml"));
+  EXPECT_FALSE(fs::exists(cut / "report.json"));
+
+  // A new run into the same directory must not overwrite the checkpoint.
+  auto r = run_command(vg() + " -q --asperities 1000 --drops 4000 --statistics streaming --no-plots --out " +
+                       cut.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("--resume"), std::string::npos) << r.out;
+  // --resume takes the checkpoint's own scene: other scene options are refused.
+  r = run_command(vg() + " --resume " + cut.string() + " --drops 5 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+
+  // Resumed with one thread: the same report as the whole run (timings aside), checkpoint gone.
+  r = run_command(vg() + " -q --resume " + cut.string() + " --threads 1 2>&1");
+  EXPECT_EQ(r.status, whole_status) << r.out;
+  EXPECT_FALSE(fs::exists(cut / "checkpoint.bin"));
+  EXPECT_EQ(comparable(cut / "report.json"), comparable(whole / "report.json"));
+  fs::remove_all(whole);
+  fs::remove_all(cut);
+  fs::remove(log);
+}
+
+TEST(Checkpoint, DamagedOrForeignCheckpointsAreRefused) {
+  const fs::path dir = fresh_dir("damaged");
+  fs::create_directories(dir);
+  // No checkpoint at all; then a file that is not one.
+  auto r = run_command(vg() + " --resume " + dir.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  std::ofstream(dir / "checkpoint.toml") << "name = \"x\"\n[ensemble]\ndrops = 4000\nstatistics = \"streaming\"\n";
+  std::ofstream(dir / "checkpoint.bin") << "not a checkpoint";
+  r = run_command(vg() + " -q --no-plots --resume " + dir.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("checkpoint"), std::string::npos) << r.out;
+  EXPECT_EQ(slurp(dir / "checkpoint.bin"), "not a checkpoint") << "a refused checkpoint is left as it was";
+  fs::remove_all(dir);
+}
+
+TEST(Checkpoint, SceneFilesKeepTheStatisticsKeys) {
+  asperity::Scene s = asperity::preset("fig3");
+  s.ensemble.statistics = asperity::Statistics::streaming;
+  s.ensemble.bins_log2 = 18;
+  const asperity::Scene back = asperity::parse_scene(asperity::to_toml(s));
+  EXPECT_EQ(back.ensemble.statistics, asperity::Statistics::streaming);
+  EXPECT_EQ(back.ensemble.bins_log2, 18u);
+  EXPECT_THROW(asperity::parse_scene("[ensemble]\nstatistics = \"fast\"\n"), std::invalid_argument);
+}
+
+// A signal while the run's output goes to a closed pipe: the message after the checkpoint raises
+// SIGPIPE during the clean-up of the first signal; the run must still end (128 + SIGTERM), not
+// pause forever (it did before the clean-up blocked further signals).
+TEST(Checkpoint, ASignalWithAClosedPipeStillEndsTheRun) {
+  const fs::path out = fresh_dir("pipe");
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);
+    ::close(fds[0]);
+    ::dup2(fds[1], 1), ::dup2(fds[1], 2);
+    // Not -q: progress and the stop message go to the closed pipe.
+    std::vector<std::string> args{"--asperities", "1000", "--drops", "20000000", "--spheres", "50000", "--statistics",
+                                  "streaming", "--no-plots", "--checkpoint-every", "0.000001", "--out", out.string()};
+    std::vector<char*> argv;
+    std::string prog = vg();
+    argv.push_back(prog.data());
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(98);
+  }
+  ::close(fds[0]), ::close(fds[1]);  // no reader any more
+  for (int i = 0; i < 6000 && !fs::exists(out / "checkpoint.bin"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ::kill(pid, SIGTERM);
+  int st = 0, waited = 0;
+  while (::waitpid(pid, &st, WNOHANG) == 0 && waited < 120000) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    waited += 20;
+  }
+  if (waited >= 120000) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &st, 0);
+    FAIL() << "the run did not end within 120 s of SIGTERM";
+  }
+  EXPECT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 128 + SIGTERM)
+      << "status " << st << (WIFSIGNALED(st) ? " killed by signal " + std::to_string(WTERMSIG(st)) : std::string());
+  fs::remove_all(out);
+}

@@ -1,0 +1,118 @@
+// The streaming path (experiments/streaming.hpp): the same drops as the raw path, the same bits for
+// any thread count, and an interrupted-and-resumed run ends with the same bits as an uninterrupted one.
+#include <gtest/gtest.h>
+
+#include <omp.h>
+
+#include "asperity/experiments/streaming.hpp"
+
+using namespace asperity;
+
+namespace {
+
+EnsembleConfig config(Mode mode, std::uint64_t spheres, std::uint64_t drops, std::uint64_t n = 1000) {
+  EnsembleConfig c;
+  c.sphere.asperities = n;
+  c.mode = mode;
+  c.spheres = spheres;
+  c.drops = drops;
+  c.seed = 11;
+  c.statistics = Statistics::streaming;
+  return c;
+}
+
+StreamState run(EnsembleConfig c, int threads) {
+  c.threads = threads;
+  return run_contact_stream(c).state;
+}
+
+}  // namespace
+
+TEST(Streaming, CountsTheSameDropsAsTheRawPath) {
+  for (const auto& c : {config(Mode::explicit_spheres, 40, 40 * 500), config(Mode::sampled, 1, 30000)}) {
+    EnsembleConfig raw = c;
+    raw.statistics = Statistics::raw;
+    const ContactSamples s = run_contact_ensemble(raw);
+    const ContactStream st = run_contact_stream(c);
+    ASSERT_TRUE(st.complete);
+    const std::vector<const std::vector<double>*> cols{&s.r_xy, &s.r_x, &s.r_y};
+    for (std::size_t q = 0; q < 3; ++q) {
+      BinnedStats b = initial_stream_state(c).stats[q];
+      const std::size_t K = c.mode == Mode::sampled ? c.drops : c.spheres, m = c.drops / K;
+      for (std::size_t i = 0; i < cols[q]->size(); ++i) {
+        const std::size_t g = (i / m) * b.blocks / K;
+        add_sample(b, g, b.ref.cdf((*cols[q])[i]));
+      }
+      EXPECT_EQ(b.fine, st.state.stats[q].fine) << q;
+      EXPECT_EQ(b.coarse, st.state.stats[q].coarse) << q;
+      double mean = 0;
+      for (double x : *cols[q]) mean += x;
+      mean /= double(cols[q]->size());
+      EXPECT_NEAR(st.state.stats[q].moments().mean, mean, 1e-12 * (std::abs(mean) + 1e-6)) << q;
+      EXPECT_EQ(st.state.stats[q].moments().n, c.drops);
+    }
+    EXPECT_EQ(st.state.core_contacts, s.core_contacts);
+    if (c.mode == Mode::explicit_spheres) {
+      EXPECT_GT(st.cross_check.queries, 0u);
+      EXPECT_EQ(st.cross_check.queries, st.cross_check.agreed);
+    }
+  }
+}
+
+TEST(Streaming, SameBitsForOneAndTwoThreads) {
+  // Small spheres (whole spheres per thread), big spheres (one sphere's units in parallel), sampled.
+  for (const auto& c : {config(Mode::explicit_spheres, 64, 64 * 300), config(Mode::explicit_spheres, 2, 2 * 80000),
+                        config(Mode::sampled, 1, 50000)})
+    EXPECT_TRUE(run(c, 1) == run(c, 2)) << to_string(c.mode) << " K = " << c.spheres;
+}
+
+TEST(Streaming, InterruptedAndResumedEqualsUninterrupted) {
+  for (const auto& c : {config(Mode::explicit_spheres, 2, 2 * 80000), config(Mode::sampled, 1, 70000)}) {
+    const StreamState whole = run(c, 2);
+    StreamState saved;
+    int waves = 0, checkpoints = 0;
+    StreamHooks h;
+    h.stop = [&] { return ++waves == 1; };
+    h.checkpoint = [&](const StreamState& s) { saved = s, ++checkpoints; };
+    const ContactStream first = run_contact_stream(c, {}, h);
+    ASSERT_FALSE(first.complete);
+    ASSERT_EQ(checkpoints, 1);
+    EXPECT_TRUE(saved == first.state);
+    EnsembleConfig one = c;
+    one.threads = 1;  // resumed with another thread count
+    const ContactStream rest = run_contact_stream(one, {}, {}, &saved);
+    ASSERT_TRUE(rest.complete);
+    EXPECT_TRUE(rest.state == whole) << to_string(c.mode);
+  }
+}
+
+TEST(Streaming, RefusesImpactsAndMismatchedCheckpoints) {
+  EnsembleConfig c = config(Mode::explicit_spheres, 4, 400);
+  c.impact.enabled = true;
+  EXPECT_THROW(run_contact_stream(c), std::invalid_argument);
+  c.impact.enabled = false;
+  StreamState other = initial_stream_state(config(Mode::explicit_spheres, 4, 400));
+  c.bins_log2 = 18;
+  EXPECT_THROW(run_contact_stream(c, {}, {}, &other), std::invalid_argument);
+}
+
+TEST(Streaming, AutomaticStatisticsStreamOnlyLargeContactRuns) {
+  EnsembleConfig c = config(Mode::explicit_spheres, 50, 50 * 1000);
+  c.statistics = Statistics::automatic;
+  EXPECT_FALSE(uses_streaming(c));
+  c.drops = kStreamingAutoDrops + 50 - kStreamingAutoDrops % 50;
+  EXPECT_TRUE(uses_streaming(c));
+  c.impact.enabled = true;  // impacts need every drop: raw samples
+  EXPECT_FALSE(uses_streaming(c));
+  c.impact.enabled = false;
+  c.statistics = Statistics::raw;
+  c.drops = (std::uint64_t{1} << 31) + 50;
+  c.spheres = 2;
+  EXPECT_THROW(validate(c), std::invalid_argument);  // raw samples stop at 2^31
+  c.statistics = Statistics::streaming;
+  EXPECT_NO_THROW(validate(c));
+  c.bins_log2 = 25;
+  EXPECT_THROW(validate(c), std::invalid_argument);
+  EXPECT_EQ(parse_statistics("streaming"), Statistics::streaming);
+  EXPECT_THROW(parse_statistics("fast"), std::invalid_argument);
+}
