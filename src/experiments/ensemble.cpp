@@ -316,6 +316,142 @@ std::vector<Backend> cross_check_backends(Backend main, std::uint64_t asperities
   return b;
 }
 
+namespace {
+
+// Sampled drops: the lowest asperities of a fresh sphere per drop from the exact order statistics.
+void sample_drops(const EnsembleConfig& c, GuardedProgress& progress, ContactSamples& s) {
+  const double R = c.sphere.radius, a = c.sphere.asperity_radius;
+  const std::uint64_t n = c.sphere.asperities;
+  s.batches = c.drops;
+  const auto t0 = Clock::now();
+  for_chunks(c.drops, 0, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
+    const Rotation identity = Rotation::Identity();  // a fresh random sphere needs no rotation
+    const Vec3 down(0, 0, -1);
+    for (std::uint64_t i = b; i < e; ++i) {
+      const auto cap = fresh_cap(n, i, c.seed);
+      const Nearest nn = brute_lowest(cap, down);
+      store(s, i, make_contact(nn, cap[nn.index], identity, R, a));
+    }
+  });
+  s.seconds_query = since(t0);
+}
+
+using Answers = std::vector<std::pair<Vec3, Nearest>>;
+
+// Rotations [b, e) of sphere k, drops [k m + b, k m + e): the same streams whichever loop runs
+// them. Every `stride`-th answer goes to `checks` (up to per_sphere) for the cross-check.
+void rotate(const EnsembleConfig& c, const detail::CheckPlan& plan, const RoughSphere& body, const ContactQuery& index,
+            std::uint64_t k, std::uint64_t b, std::uint64_t e, Answers* checks, ContactSamples& s) {
+  const std::uint64_t m = c.drops / c.spheres;
+  const double R = c.sphere.radius, a = c.sphere.asperity_radius;
+  std::vector<Rotation> q(e - b);
+  std::vector<Vec3> d(e - b);
+  std::vector<Nearest> nn(e - b);
+  for (std::uint64_t j = b; j < e; ++j) {
+    Stream st(c.seed, Purpose::orientation, k * m + j);
+    q[j - b] = random_rotation(st);
+    d[j - b] = body_down(q[j - b]);
+  }
+  index.lowest(d, nn);
+  for (std::uint64_t j = b; j < e; ++j) {
+    const Nearest& r = nn[j - b];
+    store(s, k * m + j, make_contact(r, body.centres[r.index], q[j - b], R, a));
+    if (checks && j % plan.stride == 0 && checks->size() < plan.per_sphere) checks->emplace_back(d[j - b], r);
+  }
+}
+
+// One sphere: its rotations in parallel. Returns the cross-check's seconds.
+double one_sphere(const EnsembleConfig& c, const detail::CheckPlan& plan, GuardedProgress& progress, ContactSamples& s,
+                  std::vector<detail::SphereCheck>& checks) {
+  const std::uint64_t m = c.drops;
+  auto t0 = Clock::now();
+  const RoughSphere body = make_rough_sphere(c.sphere, c.seed, 0);
+  s.seconds_generate += since(t0);
+  t0 = Clock::now();
+  const auto index = make_contact_query(c.backend, body.centres);
+  s.seconds_index += since(t0);
+  s.index_bytes = index->memory_bytes();
+  t0 = Clock::now();
+  std::vector<Answers> found((m + kChunk - 1) / kChunk);
+  for_chunks(m, 0, c.drops, progress,
+             [&](std::uint64_t b, std::uint64_t e) { rotate(c, plan, body, *index, 0, b, e, &found[b / kChunk], s); });
+  s.seconds_query += since(t0);
+  t0 = Clock::now();
+  Answers answers;
+  for (const auto& f : found)
+    for (const auto& x : f)
+      if (answers.size() < plan.per_sphere) answers.push_back(x);
+  checks[0] = detail::cross_check_sphere(c, body.centres, answers, plan.others, 0);
+  return since(t0);
+}
+
+// Spheres in parallel, each generated, indexed and queried by one thread: no parallel region per
+// sphere (OpenMP barriers cost much on a shared machine). Stage times are summed over threads;
+// `query` is the wall time of the whole loop. Returns the cross-check's seconds.
+double many_spheres(const EnsembleConfig& c, const detail::CheckPlan& plan, GuardedProgress& progress, ContactSamples& s,
+                    std::vector<detail::SphereCheck>& checks) {
+  const std::uint64_t m = c.drops / c.spheres;
+  const auto t0 = Clock::now();
+  const std::int64_t spheres = static_cast<std::int64_t>(c.spheres);
+  std::atomic<std::uint64_t> done{0};
+  double gen = 0, idx = 0, chk = 0;
+  std::size_t bytes = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : gen, idx, chk) reduction(max : bytes)
+  for (std::int64_t kk = 0; kk < spheres; ++kk) {
+    const auto k = static_cast<std::uint64_t>(kk);
+    if (progress.stopped()) continue;
+    auto t = Clock::now();
+    const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
+    gen += since(t);
+    t = Clock::now();
+    const auto index = make_contact_query(c.backend, body.centres);
+    idx += since(t);
+    bytes = std::max(bytes, index->memory_bytes());
+    Answers answers;
+    const bool checked = plan.checked(k);
+    for (std::uint64_t b = 0; b < m; b += kChunk)
+      rotate(c, plan, body, *index, k, b, std::min(m, b + kChunk), checked ? &answers : nullptr, s);
+    if (checked) {
+      t = Clock::now();
+      checks[k / plan.sphere_stride] = detail::cross_check_sphere(c, body.centres, answers, plan.others, k);
+      chk += since(t);
+    }
+    const std::uint64_t now = done.fetch_add(m) + m;
+    if (omp_get_thread_num() == 0) progress(now, c.drops);
+  }
+  progress.rethrow();
+  s.seconds_generate = gen, s.seconds_index = idx, s.index_bytes = bytes;
+  s.seconds_query = since(t0);  // wall time of the whole loop, generation and indexing included
+  return chk;
+}
+
+// The cross-check's totals; a disagreement is an error (every backend is exact).
+void collect_cross_check(const std::vector<Backend>& others, const std::vector<detail::SphereCheck>& checks, double seconds,
+                         ContactSamples& s) {
+  s.cross_check.seconds = seconds;
+  for (Backend b : others) s.cross_check.backends.emplace_back(to_string(b));
+  for (const auto& ch : checks) {
+    s.cross_check.queries += ch.queries;
+    s.cross_check.agreed += ch.agreed;
+  }
+  for (const auto& ch : checks)
+    if (!ch.first_disagreement.empty())
+      throw std::runtime_error("cross-check failed: " + std::to_string(s.cross_check.queries - s.cross_check.agreed) +
+                               " of " + std::to_string(s.cross_check.queries) +
+                               " re-answered queries disagree with the run's backend; first: " + ch.first_disagreement);
+}
+
+// K explicit spheres x M Haar rotations, contacts by the spatial query, a subsample cross-checked.
+void explicit_drops(const EnsembleConfig& c, GuardedProgress& progress, ContactSamples& s) {
+  s.batches = c.spheres;
+  const detail::CheckPlan plan = detail::check_plan(c);
+  std::vector<detail::SphereCheck> checks(plan.spheres);
+  const double seconds = c.spheres == 1 ? one_sphere(c, plan, progress, s, checks) : many_spheres(c, plan, progress, s, checks);
+  collect_cross_check(plan.others, checks, seconds, s);
+}
+
+}  // namespace
+
 ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& user_progress) {
   validate(c);
   GuardedProgress progress(user_progress);
@@ -323,122 +459,8 @@ ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& use
   ContactSamples s;
   s.mode = c.mode;
   resize(s, c.drops);
-  const double R = c.sphere.radius, a = c.sphere.asperity_radius;
-  const std::uint64_t n = c.sphere.asperities;
-
-  if (c.mode == Mode::sampled) {
-    s.batches = c.drops;
-    const auto t0 = Clock::now();
-    for_chunks(c.drops, 0, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
-      const Rotation identity = Rotation::Identity();  // a fresh random sphere needs no rotation
-      const Vec3 down(0, 0, -1);
-      for (std::uint64_t i = b; i < e; ++i) {
-        const auto cap = fresh_cap(n, i, c.seed);
-        const Nearest nn = brute_lowest(cap, down);
-        store(s, i, make_contact(nn, cap[nn.index], identity, R, a));
-      }
-    });
-    s.seconds_query = since(t0);
-  } else {
-    s.batches = c.spheres;
-    const std::uint64_t K = c.spheres, m = c.drops / K;
-    const detail::CheckPlan plan = detail::check_plan(c);
-    const std::vector<Backend>& others = plan.others;
-    const std::uint64_t check_spheres = plan.spheres, sphere_stride = plan.sphere_stride, per_sphere = plan.per_sphere,
-                        stride = plan.stride;
-    auto is_checked = [&](std::uint64_t k) { return plan.checked(k); };
-
-    // Rotations [b, e) of sphere k, drops [k m + b, k m + e): the same streams whichever loop runs them.
-    auto rotate = [&](const RoughSphere& body, const ContactQuery& index, std::uint64_t k, std::uint64_t b,
-                      std::uint64_t e, std::vector<std::pair<Vec3, Nearest>>* checks) {
-      std::vector<Rotation> q(e - b);
-      std::vector<Vec3> d(e - b);
-      std::vector<Nearest> nn(e - b);
-      for (std::uint64_t j = b; j < e; ++j) {
-        Stream st(c.seed, Purpose::orientation, k * m + j);
-        q[j - b] = random_rotation(st);
-        d[j - b] = body_down(q[j - b]);
-      }
-      index.lowest(d, nn);
-      for (std::uint64_t j = b; j < e; ++j) {
-        const Nearest& r = nn[j - b];
-        store(s, k * m + j, make_contact(r, body.centres[r.index], q[j - b], R, a));
-        if (checks && j % stride == 0 && checks->size() < per_sphere) checks->emplace_back(d[j - b], r);
-      }
-    };
-    std::vector<detail::SphereCheck> checks(check_spheres);
-    auto check_slot = [&](std::uint64_t k) -> detail::SphereCheck& { return checks[k / sphere_stride]; };
-    double seconds_check = 0;
-    if (K == 1) {
-      // One sphere: its rotations in parallel.
-      auto t0 = Clock::now();
-      const RoughSphere body = make_rough_sphere(c.sphere, c.seed, 0);
-      s.seconds_generate += since(t0);
-      t0 = Clock::now();
-      const auto index = make_contact_query(c.backend, body.centres);
-      s.seconds_index += since(t0);
-      s.index_bytes = index->memory_bytes();
-      t0 = Clock::now();
-      std::vector<std::vector<std::pair<Vec3, Nearest>>> found((m + kChunk - 1) / kChunk);
-      for_chunks(m, 0, c.drops, progress, [&](std::uint64_t b, std::uint64_t e) {
-        rotate(body, *index, 0, b, e, &found[b / kChunk]);
-      });
-      s.seconds_query += since(t0);
-      t0 = Clock::now();
-      std::vector<std::pair<Vec3, Nearest>> answers;
-      for (const auto& f : found)
-        for (const auto& x : f)
-          if (answers.size() < per_sphere) answers.push_back(x);
-      checks[0] = detail::cross_check_sphere(c, body.centres, answers, others, 0);
-      seconds_check = since(t0);
-    } else {
-      // Spheres in parallel, each generated, indexed and queried by one thread: no parallel region
-      // per sphere (OpenMP barriers cost much on a shared machine). Stage times are summed over
-      // threads; `query` is the wall time of the whole loop.
-      const auto t0 = Clock::now();
-      const std::int64_t spheres = static_cast<std::int64_t>(K);
-      std::atomic<std::uint64_t> done{0};
-      double gen = 0, idx = 0, chk = 0;
-      std::size_t bytes = 0;
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : gen, idx, chk) reduction(max : bytes)
-      for (std::int64_t kk = 0; kk < spheres; ++kk) {
-        const auto k = static_cast<std::uint64_t>(kk);
-        if (progress.stopped()) continue;
-        auto t = Clock::now();
-        const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
-        gen += since(t);
-        t = Clock::now();
-        const auto index = make_contact_query(c.backend, body.centres);
-        idx += since(t);
-        bytes = std::max(bytes, index->memory_bytes());
-        std::vector<std::pair<Vec3, Nearest>> answers;
-        for (std::uint64_t b = 0; b < m; b += kChunk)
-          rotate(body, *index, k, b, std::min(m, b + kChunk), is_checked(k) ? &answers : nullptr);
-        if (is_checked(k)) {
-          t = Clock::now();
-          check_slot(k) = detail::cross_check_sphere(c, body.centres, answers, others, k);
-          chk += since(t);
-        }
-        const std::uint64_t now = done.fetch_add(m) + m;
-        if (omp_get_thread_num() == 0) progress(now, c.drops);
-      }
-      progress.rethrow();
-      s.seconds_generate = gen, s.seconds_index = idx, s.index_bytes = bytes;
-      s.seconds_query = since(t0);  // wall time of the whole loop, generation and indexing included
-      seconds_check = chk;
-    }
-    s.cross_check.seconds = seconds_check;
-    for (Backend b : others) s.cross_check.backends.emplace_back(to_string(b));
-    for (const auto& ch : checks) {
-      s.cross_check.queries += ch.queries;
-      s.cross_check.agreed += ch.agreed;
-    }
-    for (const auto& ch : checks)
-      if (!ch.first_disagreement.empty())
-        throw std::runtime_error("cross-check failed: " + std::to_string(s.cross_check.queries - s.cross_check.agreed) +
-                                 " of " + std::to_string(s.cross_check.queries) +
-                                 " re-answered queries disagree with the run's backend; first: " + ch.first_disagreement);
-  }
+  if (c.mode == Mode::sampled) sample_drops(c, progress, s);
+  else explicit_drops(c, progress, s);
   s.core_contacts = static_cast<std::uint64_t>(std::count(s.core.begin(), s.core.end(), std::uint8_t{1}));
   if (c.impact.enabled) run_impacts(c, s);
   return s;
