@@ -358,7 +358,6 @@ void run_gnuplot(const char* who, const fs::path& png, const std::function<std::
   if (png.empty()) throw std::invalid_argument(w + ": empty output path");
   if (!png.has_filename()) throw std::invalid_argument(w + ": output path has no file name");
   const std::string suffix = random_suffix();
-  Cleanup cleanup;
 
   // Private work directory for script and gnuplot's stderr.
   std::error_code ec;
@@ -369,19 +368,21 @@ void run_gnuplot(const char* who, const fs::path& png, const std::function<std::
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
   if (stem.size() > 64) stem.resize(64);
   const fs::path work = tmp_root / ("asperity-plot-" + stem + "-" + suffix);
-  InterruptCleanup work_on_signal(work);  // registered before it exists
+  // Gnuplot renders beside the target so the final rename is atomic (same filesystem).
+  const fs::path out = png.parent_path() / (png.filename().string() + "." + suffix + ".tmp");
+  // Registered before they exist, and released only after `cleanup` (declared after them, so
+  // destroyed first) removed them: a signal in between still finds them (interrupt.hpp).
+  InterruptCleanup work_on_signal(work);
+  InterruptCleanup out_on_signal(out, InterruptCleanup::Kind::file);
+  out_on_signal.created();  // gnuplot creates it: the handler kills gnuplot before removing it
+  Cleanup cleanup;
+  cleanup.paths.push_back(out);
   const bool made = fs::create_directory(work, ec);
   work_on_signal.created();
   if (!made || ec)
     throw std::runtime_error(w + ": cannot create " + work.string() +
                              (ec ? ": " + ec.message() : std::string(": already exists")));
   cleanup.paths.push_back(work);
-
-  // Gnuplot renders beside the target so the final rename is atomic (same filesystem).
-  const fs::path out = png.parent_path() / (png.filename().string() + "." + suffix + ".tmp");
-  InterruptCleanup out_on_signal(out, InterruptCleanup::Kind::file);
-  out_on_signal.created();  // gnuplot creates it: the handler kills gnuplot before removing it
-  cleanup.paths.push_back(out);
 
   const fs::path script = work / "figure.gp";
   const fs::path err = work / "gnuplot.err";
