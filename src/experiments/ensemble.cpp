@@ -343,21 +343,12 @@ using Answers = std::vector<std::pair<Vec3, Nearest>>;
 void rotate(const EnsembleConfig& c, const detail::CheckPlan& plan, const RoughSphere& body, const ContactQuery& index,
             std::uint64_t k, std::uint64_t b, std::uint64_t e, Answers* checks, ContactSamples& s) {
   const std::uint64_t m = c.drops / c.spheres;
-  const double R = c.sphere.radius, a = c.sphere.asperity_radius;
-  std::vector<Rotation> q(e - b);
-  std::vector<Vec3> d(e - b);
-  std::vector<Nearest> nn(e - b);
-  for (std::uint64_t j = b; j < e; ++j) {
-    Stream st(c.seed, Purpose::orientation, k * m + j);
-    q[j - b] = random_rotation(st);
-    d[j - b] = body_down(q[j - b]);
-  }
-  index.lowest(d, nn);
-  for (std::uint64_t j = b; j < e; ++j) {
-    const Nearest& r = nn[j - b];
-    store(s, k * m + j, make_contact(r, body.centres[r.index], q[j - b], R, a));
-    if (checks && j % plan.stride == 0 && checks->size() < plan.per_sphere) checks->emplace_back(d[j - b], r);
-  }
+  detail::query_rotations(c, m, body.centres, index, k, b, e,
+                          [&](std::uint64_t j, const Contact& contact, const Vec3& down, const Nearest& r) {
+                            store(s, k * m + j, contact);
+                            if (checks && j % plan.stride == 0 && checks->size() < plan.per_sphere)
+                              checks->emplace_back(down, r);
+                          });
 }
 
 // One sphere: its rotations in parallel. Returns the cross-check's seconds.

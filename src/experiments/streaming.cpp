@@ -89,21 +89,11 @@ struct Driver {
   // Rotations [j kUnit, ...) of sphere k: the same streams as run_contact_ensemble's.
   void explicit_unit(const Built& b, std::uint64_t k, std::uint64_t j, int t, Slot& slot) const {
     const std::uint64_t lo = j * kUnit, hi = std::min(m, lo + kUnit);
-    std::vector<Rotation> q(hi - lo);
-    std::vector<Vec3> d(hi - lo);
-    std::vector<Nearest> nn(hi - lo);
-    for (std::uint64_t r = lo; r < hi; ++r) {
-      Stream st(c.seed, Purpose::orientation, k * m + r);
-      q[r - lo] = random_rotation(st);
-      d[r - lo] = body_down(q[r - lo]);
-    }
-    b.index->lowest(d, nn);
     const std::size_t g = sink.block(k);
-    for (std::uint64_t r = lo; r < hi; ++r) {
-      const Nearest& a = nn[r - lo];
-      sink.count(t, g, make_contact(a, b.body.centres[a.index], q[r - lo], c.sphere.radius, c.sphere.asperity_radius),
-                 slot);
-    }
+    detail::query_rotations(c, m, b.body.centres, *b.index, k, lo, hi,
+                            [&](std::uint64_t, const Contact& contact, const Vec3&, const Nearest&) {
+                              sink.count(t, g, contact, slot);
+                            });
   }
 
   // Sampled: "sphere" k is drop k, from the exact law of the lowest asperities (no geometry).
