@@ -41,30 +41,8 @@ std::string slurp(const fs::path& f) {
   return s.str();
 }
 
-// validate-geometry with default signal dispositions, output into `log`.
-pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
-  std::fflush(nullptr);
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);
-    if (!std::freopen(log.c_str(), "w", stdout) || !std::freopen(log.c_str(), "a", stderr)) ::_exit(99);
-    std::vector<char*> argv;
-    std::string prog = vg();
-    argv.push_back(prog.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    ::_exit(98);
-  }
-  return pid;
-}
-
-int wait_status(pid_t pid) {
-  int st = 0;
-  ::waitpid(pid, &st, 0);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : 1000 + WTERMSIG(st);
-}
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) { return asperity::testing::spawn_cli(vg(), args, log); }
+using asperity::testing::wait_status;
 
 // The report without what may differ between an interrupted-and-resumed run and a whole one.
 nlohmann::json comparable(const fs::path& report) {

@@ -62,34 +62,8 @@ int plot_temporaries_of(pid_t pid) {
 
 bool has_gnuplot() { return std::system("gnuplot -e 'set terminal pngcairo' >/dev/null 2>&1") == 0; }
 
-// Starts validate-geometry with default signal dispositions (a shell's `&` would ignore SIGINT),
-// stdout and stderr into `log`.
-pid_t spawn(const std::vector<std::string>& args, const fs::path& log) {
-  std::fflush(nullptr);  // the child must not repeat our buffered output
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);
-    sigset_t none;
-    sigemptyset(&none);
-    ::sigprocmask(SIG_SETMASK, &none, nullptr);
-    if (!std::freopen(log.c_str(), "w", stdout) || !std::freopen(log.c_str(), "a", stderr)) ::_exit(99);
-    std::vector<char*> argv;
-    std::string prog = vg();
-    argv.push_back(prog.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    ::_exit(98);
-  }
-  return pid;
-}
-
-int wait_status(pid_t pid) {
-  int st = 0;
-  ::waitpid(pid, &st, 0);
-  return WIFEXITED(st) ? WEXITSTATUS(st) : 1000 + WTERMSIG(st);
-}
+pid_t spawn(const std::vector<std::string>& args, const fs::path& log) { return asperity::testing::spawn_cli(vg(), args, log); }
+using asperity::testing::wait_status;
 
 const std::vector<std::string> kRunFiles = {"r_x.png", "r_xy.png", "r_y.png", "report.json", "report.txt"};
 
