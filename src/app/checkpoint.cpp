@@ -93,47 +93,64 @@ std::string checkpoint_key(const Scene& s) {
   return to_toml(k);
 }
 
-void write_checkpoint(const std::filesystem::path& dir, const Scene& s, const StreamState& st) {
-  write_file_atomic(dir / kCheckpointScene, to_toml(s));
-  write_file_atomic(dir / kCheckpointState, serialise(checkpoint_key(s), st));
+std::string checkpoint_state_name(const StreamShare& share) {
+  if (share.ranks <= 1) return kCheckpointState;
+  return "checkpoint.rank-" + std::to_string(share.rank) + "-of-" + std::to_string(share.ranks) + ".bin";
 }
 
+void write_checkpoint(const std::filesystem::path& dir, const Scene& s, const StreamState& st) {
+  if (s.share.rank == 0) write_file_atomic(dir / kCheckpointScene, to_toml(s));
+  write_file_atomic(dir / checkpoint_state_name(s.share), stream_state_bytes(s, st));
+}
+
+std::string stream_state_bytes(const Scene& s, const StreamState& st) { return serialise(checkpoint_key(s), st); }
+
 StreamState read_checkpoint(const std::filesystem::path& dir, const Scene& s) {
-  const auto path = dir / kCheckpointState;
+  const auto path = dir / checkpoint_state_name(s.share);
   std::ifstream f(path, std::ios::binary);
-  if (!f) throw std::invalid_argument("--resume: no checkpoint " + path.string());
+  if (!f) {
+    std::string why = "--resume: no checkpoint " + path.string();
+    if (s.share.ranks > 1 && std::filesystem::exists(dir / kCheckpointState))
+      why += " (" + (dir / kCheckpointState).string() + " was written by one process: resume it without mpirun)";
+    else if (s.share.ranks == 1)
+      why += " (a run split across P processes writes checkpoint.rank-R-of-P.bin: resume it with mpirun -np P)";
+    throw std::invalid_argument(why);
+  }
   const std::string in((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  Reader r{in, 0, path.string()};
+  return stream_state_from_bytes(in, s, path.string());
+}
+
+StreamState stream_state_from_bytes(const std::string& in, const Scene& s, const std::string& what) {
+  Reader r{in, 0, what};
   r.need(sizeof kMagic - 1);
-  if (in.compare(0, sizeof kMagic - 1, kMagic) != 0)
-    throw std::invalid_argument(path.string() + ": not a checkpoint of this version");
+  if (in.compare(0, sizeof kMagic - 1, kMagic) != 0) throw std::invalid_argument(what + ": not a checkpoint of this version");
   r.at = sizeof kMagic - 1;
   if (r.text() != checkpoint_key(s))
-    throw std::invalid_argument(path.string() + ": written for another scene than " + (dir / kCheckpointScene).string() +
+    throw std::invalid_argument(what + ": written for another scene than " + kCheckpointScene +
                                 " with these options (only --threads, --quiet, --no-plots and --checkpoint-every may change)");
   StreamState st = initial_stream_state(s.ensemble);
   st.next_unit = r.get<std::uint64_t>(), st.core_contacts = r.get<std::uint64_t>();
   st.check_queries = r.get<std::uint64_t>(), st.check_agreed = r.get<std::uint64_t>();
   st.index_bytes = r.get<std::uint64_t>();
-  if (r.get<std::uint64_t>() != st.stats.size()) throw std::invalid_argument(path.string() + ": damaged checkpoint");
+  if (r.get<std::uint64_t>() != st.stats.size()) throw std::invalid_argument(what + ": damaged checkpoint");
   for (auto& b : st.stats) {
     const auto kind = r.get<Reference::Kind>();
     const auto sigma = r.get<double>();
     const auto fine = r.get<unsigned>(), coarse = r.get<unsigned>();
     const auto blocks = r.get<std::size_t>();
     if (kind != b.ref.kind || sigma != b.ref.sigma || fine != b.fine_log2 || coarse != b.coarse_log2 || blocks != b.blocks)
-      throw std::invalid_argument(path.string() + ": its histograms do not match this scene");
+      throw std::invalid_argument(what + ": its histograms do not match this scene");
     b.fine = r.vector<std::uint64_t>(b.fine.size());
     b.coarse = r.vector<std::uint64_t>(b.coarse.size());
     b.block_moments = r.vector<Moments>(b.block_moments.size());
   }
-  if (r.at != in.size()) throw std::invalid_argument(path.string() + ": damaged checkpoint (trailing bytes)");
+  if (r.at != in.size()) throw std::invalid_argument(what + ": damaged checkpoint (trailing bytes)");
   return st;
 }
 
-void remove_checkpoint(const std::filesystem::path& dir) {
+void remove_checkpoint(const std::filesystem::path& dir, const StreamShare& share) {
   std::error_code ec;
-  std::filesystem::remove(dir / kCheckpointState, ec);
+  for (int r = 0; r < share.ranks; ++r) std::filesystem::remove(dir / checkpoint_state_name({r, share.ranks}), ec);
   std::filesystem::remove(dir / kCheckpointScene, ec);
 }
 

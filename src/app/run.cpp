@@ -299,8 +299,8 @@ void write_scene_cor_table(const Scene& s, const Progress& progress, const std::
   o.table += line.str();
 }
 
-SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
-  const GeometryReport r = run_scene(s, progress, dir);
+SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::filesystem::path& dir, Collective* group) {
+  const GeometryReport r = run_scene(s, progress, dir, group);
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
@@ -319,10 +319,10 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
 
 }  // namespace
 
-GeometryReport run_scene(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
+GeometryReport run_scene(const Scene& s, const Progress& progress, const std::filesystem::path& dir, Collective* group) {
   validate(s);
   Plan plan = make_plan(s);
-  if (uses_streaming(plan.scene.ensemble)) return run_stream_scene(std::move(plan), s, progress, dir);
+  if (uses_streaming(plan.scene.ensemble)) return run_stream_scene(std::move(plan), s, progress, dir, {}, nullptr, group);
   const Scene& run = plan.scene;
   const ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
   auto t0 = Clock::now();
@@ -370,12 +370,16 @@ std::string show(double v) {
 void check_scene_inputs(const Scene& s) {
   validate(s);
   // A checkpoint in the output directory belongs to an interrupted streaming run: never overwritten.
-  const bool checkpoint = std::filesystem::exists(s.out / kCheckpointState);
+  const auto state = s.out / checkpoint_state_name(s.share);
+  const bool checkpoint = std::filesystem::exists(state);
   if (s.resume && !uses_streaming(s.ensemble))
     throw std::invalid_argument("--resume: the scene of " + s.out.string() + " does not stream (statistics = raw)");
-  if (s.resume && !checkpoint) throw std::invalid_argument("--resume: no checkpoint " + (s.out / kCheckpointState).string());
-  if (!s.resume && checkpoint && uses_streaming(s.ensemble))
-    throw std::invalid_argument("--out: " + (s.out / kCheckpointState).string() +
+  if (s.resume && !checkpoint) read_checkpoint(s.out, s);  // throws, saying which process count wrote what
+  // checkpoint.toml too: this run's checkpoints would overwrite it (another process count's, or a
+  // run interrupted between its two files).
+  const auto scene_file = s.out / kCheckpointScene;
+  if (!s.resume && uses_streaming(s.ensemble) && (checkpoint || std::filesystem::exists(scene_file)))
+    throw std::invalid_argument("--out: " + (checkpoint ? state : scene_file).string() +
                                 " is the checkpoint of an interrupted run: continue it with --resume " + s.out.string() +
                                 ", or remove it");
   if (!s.mesh) return;
@@ -466,7 +470,7 @@ std::string_view to_string(RunKind k) {
 }
 
 SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log,
-                             const std::filesystem::path& dir) {
+                             const std::filesystem::path& dir, Collective* group) {
   check_scene_inputs(s);  // validate(s), and a mesh body's derived quantities, before any file is written
 #ifdef _OPENMP
   if (s.ensemble.threads > 0) omp_set_num_threads(s.ensemble.threads);  // as run_contact_ensemble does
@@ -478,7 +482,7 @@ SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostr
   const std::filesystem::path& into = dir.empty() ? own->dir() : dir;
   SceneOutput o;
   switch (run_kind(s)) {
-    case RunKind::sphere: o = run_sphere(s, progress, into); break;
+    case RunKind::sphere: o = run_sphere(s, progress, into, group); break;
     case RunKind::radii: o = run_radii(s, progress, into); break;
     case RunKind::mesh: o = run_mesh(s, progress, into); break;
     case RunKind::bounce: o = run_bounce(s, progress, log, into); break;

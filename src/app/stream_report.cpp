@@ -246,17 +246,30 @@ void write_band_png(const std::filesystem::path& png, const BandFigure& fig) {
 
 namespace {
 
-// The stream of `run` (the planned ensemble of scene s) with checkpoints in s.out (not the staging
-// directory: a checkpoint outlives an interrupted run): every s.checkpoint_seconds, and when a
-// signal arrives (validate-geometry: the signal waits for the end of a wave, the checkpoint is
-// written, then the signal ends the process as usual, exit 128 + signal).
+// Rank 0 receives every share and merges them (disjoint blocks: the same bits as one process);
+// the others send theirs. Timings stay rank 0's own.
+void gather_shares(const Scene& s, ContactStream& cs, Collective& group) {
+  const std::vector<std::string> parts = group.gather(stream_state_bytes(s, cs.state));
+  for (std::size_t r = 1; r < parts.size(); ++r)
+    merge_shares(cs.state, stream_state_from_bytes(parts[r], s, "the share of rank " + std::to_string(r)));
+  if (group.rank() != 0) return;
+  cs.complete = true;
+  cs.index_bytes = static_cast<std::size_t>(cs.state.index_bytes);
+  cs.cross_check.queries = cs.state.check_queries, cs.cross_check.agreed = cs.state.check_agreed;
+}
+
+// The stream of `run` (the planned ensemble of scene s), or of this process's share s.share, with
+// checkpoints in s.out (not the staging directory: a checkpoint outlives an interrupted run): every
+// s.checkpoint_seconds, and when a signal arrives (validate-geometry: the signal waits for the end
+// of a wave, the checkpoint is written, then the signal ends the process as usual, exit 128 +
+// signal). With a group, every process learns whether all completed (a process that completed
+// while another stopped writes its finished share too, so that the resume skips it), and the
+// shares are gathered at rank 0, which returns the merged stream.
 ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run, const Progress& progress,
-                                      const StreamHooks& given, const StreamState* resume) {
-  StreamState resumed;
-  if (!resume && s.resume) resumed = read_checkpoint(s.out, s), resume = &resumed;
+                                      const StreamHooks& given, const StreamState* resume, Collective* group) {
+  StreamHooks h = given;
   using Clock = std::chrono::steady_clock;
   auto last = Clock::now();
-  StreamHooks h = given;
   if (!h.stop) h.stop = [] { return interrupt_pending() != 0; };
   if (!h.checkpoint_due && s.checkpoint_seconds > 0)
     h.checkpoint_due = [&] { return std::chrono::duration<double>(Clock::now() - last).count() >= s.checkpoint_seconds; };
@@ -267,24 +280,42 @@ ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run,
     };
   std::optional<InterruptDeferral> defer;
   if (interrupt_cleanup_installed()) defer.emplace();
-  ContactStream cs = run_contact_stream(run, progress, h, resume);
-  if (!cs.complete) {
-    std::cerr << "\nvalidate-geometry: stopped after " << cs.state.stats[0].n() << " of " << run.drops
-              << " drops; checkpoint in " << (s.out / kCheckpointState).string()
-              << ": continue with validate-geometry --resume " << s.out.string() << "\n";
-    defer.reset();  // a pending signal ends the process here
-    throw std::runtime_error("the streaming run stopped before its last drop; checkpoint in " +
-                             (s.out / kCheckpointState).string());
+  // 0 complete, 1 stopped (checkpoint written), 2 failed: the worst of all processes decides.
+  int status = 0;
+  std::string error;
+  ContactStream cs;
+  try {
+    StreamState resumed;
+    if (!resume && s.resume) resumed = read_checkpoint(s.out, s), resume = &resumed;
+    cs = run_contact_stream(run, progress, h, resume, s.share);
+    status = cs.complete ? 0 : 1;
+  } catch (const std::exception& ex) {
+    if (!group) throw;
+    status = 2, error = ex.what();
   }
+  if (group) status = group->max(status);
+  if (status == 2)
+    throw std::runtime_error(error.empty() ? "another process of this run failed (its message is above)" : error);
+  if (status == 1) {
+    if (cs.complete) h.checkpoint(cs.state);
+    const std::string where = (s.out / checkpoint_state_name(s.share)).string();
+    if (s.share.rank == 0)
+      std::cerr << "\nvalidate-geometry: stopped after " << cs.state.stats[0].n() << " of " << share_drops(run, s.share)
+                << " drops" << (s.share.ranks > 1 ? " of rank 0's share" : "") << "; checkpoint in " << where
+                << ": continue with " << (s.share.ranks > 1 ? "mpirun -np " + std::to_string(s.share.ranks) + " " : "")
+                << "validate-geometry --resume " << s.out.string() << "\n";
+    defer.reset();  // a pending signal ends the process here
+    throw std::runtime_error("the streaming run stopped before its last drop; checkpoint in " + where);
+  }
+  if (group) gather_shares(s, cs, *group);
   return cs;
 }
-
 }  // namespace
 
 GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
-                                const StreamHooks& hooks, const StreamState* resume) {
+                                const StreamHooks& hooks, const StreamState* resume, Collective* group) {
   const Scene& run = plan.scene;
-  const ContactStream cs = stream_with_checkpoints(s, run.ensemble, progress, hooks, resume);
+  const ContactStream cs = stream_with_checkpoints(s, run.ensemble, progress, hooks, resume, group);
   auto t0 = std::chrono::steady_clock::now();
   auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   GeometryReport r = analyse_stream(run, cs);
@@ -308,6 +339,11 @@ GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progr
   r.plan = std::move(plan.stages);
   r.scene_toml = to_toml(s);
   return r;
+}
+
+void run_stream_share(const Scene& s, Collective& group) {
+  const Plan plan = make_plan(s);
+  stream_with_checkpoints(s, plan.scene.ensemble, {}, {}, nullptr, &group);
 }
 
 }  // namespace asperity

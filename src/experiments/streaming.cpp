@@ -173,7 +173,45 @@ void big_sphere_wave(Driver& dr, StreamState& st, std::uint64_t u0, std::uint64_
     dr.explicit_unit(b, k, std::uint64_t(u) % us, omp_get_thread_num(), slots[std::uint64_t(u) - u0]);
 }
 
+// Units per sphere and in all: explicit runs K spheres of ceil(m / kUnit) units; sampled runs one
+// unit per drop.
+struct Layout {
+  std::uint64_t K, m, us;
+};
+Layout layout(const EnsembleConfig& c) {
+  const bool sampled = c.mode == Mode::sampled;
+  const std::uint64_t K = sampled ? c.drops : c.spheres, m = sampled ? 1 : c.drops / c.spheres;
+  return {K, m, (m + kUnit - 1) / kUnit};
+}
+
 }  // namespace
+
+std::pair<std::uint64_t, std::uint64_t> share_units(const EnsembleConfig& c, const StreamShare& share) {
+  if (!(share.ranks >= 1 && share.rank >= 0 && share.rank < share.ranks))
+    throw std::invalid_argument("stream share: rank " + std::to_string(share.rank) + " of " +
+                                std::to_string(share.ranks) + " processes");
+  const Layout l = layout(c);
+  const std::uint64_t G = std::min<std::uint64_t>(l.K, kStreamBlocks), P = std::uint64_t(share.ranks);
+  // The first sphere of block g (block(k) = floor(k G / K)) is ceil(g K / G); g K < 2^58.
+  auto first_sphere = [&](std::uint64_t g) { return (g * l.K + G - 1) / G; };
+  const std::uint64_t r = std::uint64_t(share.rank);
+  return {first_sphere(r * G / P) * l.us, first_sphere((r + 1) * G / P) * l.us};
+}
+
+std::uint64_t share_drops(const EnsembleConfig& c, const StreamShare& share) {
+  const Layout l = layout(c);
+  const auto [u0, u1] = share_units(c, share);
+  return (u1 - u0) / l.us * l.m;
+}
+
+void merge_shares(StreamState& into, const StreamState& o) {
+  if (into.stats.size() != o.stats.size()) throw std::invalid_argument("merge_shares: different statistics");
+  for (std::size_t q = 0; q < into.stats.size(); ++q) into.stats[q].merge(o.stats[q]);
+  into.next_unit = std::max(into.next_unit, o.next_unit);
+  into.core_contacts += o.core_contacts;
+  into.check_queries += o.check_queries, into.check_agreed += o.check_agreed;
+  into.index_bytes = std::max(into.index_bytes, o.index_bytes);
+}
 
 StreamState initial_stream_state(const EnsembleConfig& c) {
   const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * areal_density(c.sphere.asperities, c.sphere.radius));
@@ -187,7 +225,7 @@ StreamState initial_stream_state(const EnsembleConfig& c) {
 }
 
 ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progress, const StreamHooks& hooks,
-                                 const StreamState* resume) {
+                                 const StreamState* resume, const StreamShare& share) {
   validate(c);
   if (c.impact.enabled) throw std::invalid_argument("streaming statistics: contact statistics only (no impact experiment)");
   if (c.threads > 0) omp_set_num_threads(c.threads);
@@ -199,8 +237,12 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
     throw std::invalid_argument("resume: the checkpoint's statistics do not match this run's configuration");
   StreamState& st = out.state;
   const bool sampled = c.mode == Mode::sampled;
-  const std::uint64_t K = sampled ? c.drops : c.spheres, m = sampled ? 1 : c.drops / c.spheres;
-  const std::uint64_t us = (m + kUnit - 1) / kUnit, total_units = K * us;
+  const auto [K, m, us] = layout(c);
+  const auto [first_unit, total_units] = share_units(c, share);
+  if (!resume) st.next_unit = first_unit;
+  if (st.next_unit < first_unit || st.next_unit > total_units)
+    throw std::invalid_argument("resume: the checkpoint's next drop lies outside this process's share of the run");
+  const std::uint64_t share_total = share_drops(c, share);
   out.spheres = K, out.rotations = m;
   Sink sink{st.stats, {}, K, st.stats[0].blocks};
   sink.fine.assign(std::size_t(omp_get_max_threads()) * kQ, std::vector<std::uint64_t>(st.stats[0].fine_bins(), 0));
@@ -227,7 +269,7 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
     merge_slots(st, sink, slots, u, us);
     st.index_bytes = std::max<std::uint64_t>(st.index_bytes, dr.bytes);
     u = st.next_unit = u1;
-    if (progress) progress(std::min(c.drops, (u / us) * m + (u % us) * kUnit), c.drops);
+    if (progress) progress(std::min(share_total, ((u - first_unit) / us) * m + (u % us) * kUnit), share_total);
     const bool stop = u < total_units && hooks.stop && hooks.stop();
     if (stop || (u < total_units && hooks.checkpoint_due && hooks.checkpoint_due())) {
       sink.fold();

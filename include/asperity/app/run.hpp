@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "asperity/experiments/ensemble.hpp"
+#include "asperity/app/collective.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/app/scene.hpp"
@@ -16,7 +17,10 @@ namespace asperity {
 /// Runs only the stages make_plan(s) lists (figures are written into `dir`, default s.out, when
 /// planned; the report file is not written). The report carries the plan with stage times and
 /// the scene as TOML (to_toml(s)). Throws std::invalid_argument for an invalid scene.
-GeometryReport run_scene(const Scene& s, const Progress& progress = {}, const std::filesystem::path& dir = {});
+/// `group` given (rank 0 of a run split across processes; s.share its share): a streaming run
+/// gathers the other processes' shares before the analysis (run_stream_share runs them).
+GeometryReport run_scene(const Scene& s, const Progress& progress = {}, const std::filesystem::path& dir = {},
+                         Collective* group = nullptr);
 
 /// validate(s), then what needs the files a scene refers to: a mesh body's mesh is read and its
 /// derived quantities checked against the supported ranges (size, mass and inertia, asperity
@@ -53,7 +57,8 @@ struct SceneOutput {
 /// `dir` given (validate-geometry: an OutputStaging's dir()): the files are written there under
 /// their final names and the caller commits them. `dir` empty: they are staged in s.out and
 /// renamed into place when the run succeeded; on an exception s.out is left as it was.
+/// `group`: as run_scene (only streaming sphere runs are split; others run on rank 0 alone).
 SceneOutput run_scene_output(const Scene& s, const Progress& progress = {}, std::ostream* log = nullptr,
-                             const std::filesystem::path& dir = {});
+                             const std::filesystem::path& dir = {}, Collective* group = nullptr);
 
 }  // namespace asperity

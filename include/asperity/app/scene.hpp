@@ -13,6 +13,7 @@
 #include "asperity/core/body.hpp"
 #include "asperity/experiments/bounce.hpp"
 #include "asperity/experiments/ensemble.hpp"
+#include "asperity/experiments/streaming.hpp"
 
 namespace asperity {
 
@@ -84,6 +85,9 @@ struct Scene {
   /// checkpoint_seconds (0: only on SIGINT/SIGTERM) in `out`; resume: continue from it (app/checkpoint.hpp).
   double checkpoint_seconds = 300;
   bool resume = false;
+  /// This process's share of a run split across processes (validate-geometry under mpirun;
+  /// streaming runs only, experiments/streaming.hpp). Not written to scene files.
+  StreamShare share;
 
   friend bool operator==(const Scene&, const Scene&) = default;
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "asperity/app/collective.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/experiments/streaming.hpp"
@@ -31,7 +32,15 @@ void write_band_png(const std::filesystem::path& png, const BandFigure& fig);
 
 /// run_scene's streaming branch (uses_streaming): the stream, its analysis, the finite-N figure
 /// (finite_n.png in `dir`, default s.out, when plots are planned) and the plan with stage times.
+/// `group` (rank 0 of a split run, s.share its share): the other processes' shares are gathered
+/// and merged before the analysis; the report is the same bits as one process's (timings aside).
 GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
-                                const StreamHooks& hooks = {}, const StreamState* resume = nullptr);
+                                const StreamHooks& hooks = {}, const StreamState* resume = nullptr,
+                                Collective* group = nullptr);
+
+/// A process of rank > 0 of a split run: runs its share s.share of the planned stream (with its own
+/// checkpoints) and sends it to rank 0. Throws as rank 0's run does when any process failed or
+/// stopped (std::runtime_error), so every process ends with the same outcome.
+void run_stream_share(const Scene& s, Collective& group);
 
 }  // namespace asperity

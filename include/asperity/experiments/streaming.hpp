@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "asperity/experiments/ensemble.hpp"
@@ -60,10 +61,31 @@ struct ContactStream {
   std::size_t memory_bytes = 0;  ///< of the statistics (all threads' histograms), independent of the drops
 };
 
-/// Runs (or continues from `resume`, a state of the same config) the ensemble of `c` on the
-/// streaming path. Throws std::invalid_argument for an invalid config (validate) or an impact
-/// experiment, std::runtime_error when the cross-check disagrees (as run_contact_ensemble).
+/// One process's share of a run split across `ranks` processes (validate-geometry under mpirun):
+/// whole blocks of spheres, rank r the blocks [r G / ranks, (r + 1) G / ranks). Every block's
+/// moments are accumulated by one process in drop order, so merging the shares (merge_shares)
+/// gives the same bits as one process running everything.
+struct StreamShare {
+  int rank = 0, ranks = 1;
+  friend bool operator==(const StreamShare&, const StreamShare&) = default;
+};
+
+/// The units [first, second) of `share` (units as StreamState::next_unit counts them).
+/// Throws std::invalid_argument unless 0 <= rank < ranks.
+std::pair<std::uint64_t, std::uint64_t> share_units(const EnsembleConfig& c, const StreamShare& share);
+
+/// The drops of `share`.
+std::uint64_t share_drops(const EnsembleConfig& c, const StreamShare& share);
+
+/// Adds the share `o` to `into` (counts added, block moments merged, largest index kept). Shares of
+/// one run own disjoint blocks, so the order of the calls does not change a bit.
+void merge_shares(StreamState& into, const StreamState& o);
+
+/// Runs (or continues from `resume`, a state of the same config and share) the ensemble of `c`, or
+/// its `share`, on the streaming path. Throws std::invalid_argument for an invalid config (validate)
+/// or an impact experiment, std::runtime_error when the cross-check disagrees (as
+/// run_contact_ensemble).
 ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progress = {}, const StreamHooks& hooks = {},
-                                 const StreamState* resume = nullptr);
+                                 const StreamState* resume = nullptr, const StreamShare& share = {});
 
 }  // namespace asperity

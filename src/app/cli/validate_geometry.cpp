@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <new>
 #include <sstream>
 #include <optional>
@@ -26,7 +27,9 @@
 #include "asperity/app/resources.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene.hpp"
+#include "asperity/app/stream_report.hpp"
 #include "app/cli/options.hpp"
+#include "app/cli/processes.hpp"
 #include "app/cli/progress_line.hpp"
 
 namespace fs = std::filesystem;
@@ -37,23 +40,26 @@ using asperity::cli::ProgressLine;
 namespace {
 
 // The command line, checked as far as it can be before the output directory is touched. Returns
-// the exit status when the run ends here (--help: 0; bad input: 2).
-std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& quiet) {
+// the exit status when the run ends here (--help: 0; bad input: 2). `share`: this process's share
+// of a split run (its checkpoint file is checked); only rank 0 prints help and errors.
+std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& quiet, const StreamShare& share,
+                                     std::string& error) {
   try {
     const std::vector<std::string> args(argv + 1, argv + argc);
     const cli::Options o = cli::parse_command_line(args);
     if (o.help) {
-      std::cout << o.help_text;
+      if (share.rank == 0) std::cout << o.help_text;
       return 0;
     }
     scene = o.scene;
-    quiet = o.quiet;
+    scene.share = uses_streaming(scene.ensemble) && !scene.bounce.enabled && !scene.mesh && !scene.radii ? share : StreamShare{};
+    quiet = o.quiet || share.rank > 0;
     if (scene.plots && !plotting_available())
       throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
     check_scene_inputs(scene);
     check_memory(scene);
   } catch (const std::exception& ex) {
-    std::cerr << "validate-geometry: error: " << ex.what() << "\n";
+    error = ex.what();
     return 2;
   }
   return std::nullopt;
@@ -82,7 +88,7 @@ void print_outcome(const Scene& scene, const SceneOutput& r, const std::vector<f
 // place only when the whole run succeeded (the report last): a failed or interrupted run
 // leaves the directory as it found it (output_staging.hpp). `staging_dir` is set as soon as it
 // exists, for the messages. Returns the exit status.
-int run_staged(const Scene& scene, bool quiet, std::string& staging_dir) {
+int run_staged(const Scene& scene, bool quiet, std::string& staging_dir, Collective* group) {
   std::optional<OutputStaging> staging;
   try {
     staging.emplace(scene.out);
@@ -94,7 +100,7 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir) {
   ProgressLine progress(!quiet, stderr, ::isatty(2) != 0, &ProgressLine::steady_seconds, 1.0,
                         sequences ? "sequences" : "drops");
   ProgressLine::Log log(progress);
-  const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &log, staging->dir());
+  const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &log, staging->dir(), group);
   progress.finish();
   for (const auto& f : r.files) staging->add(f);
   const auto reports = write_report_files(staging->dir(), scene.report, r.json, r.table);
@@ -102,7 +108,7 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir) {
   staging->add(reports.at(0).filename().string());
   staging->commit();
   staging.reset();
-  if (uses_streaming(scene.ensemble)) remove_checkpoint(scene.out);  // this run's (or the run it continued)
+  if (uses_streaming(scene.ensemble)) remove_checkpoint(scene.out, scene.share);  // this run's (or the run it continued)
   print_outcome(scene, r, reports);
   return r.rejected ? 1 : 0;
 }
@@ -112,6 +118,64 @@ std::string in_place(std::string message, const std::string& staging_dir, const 
   for (std::size_t at; !staging_dir.empty() && (at = message.find(staging_dir)) != std::string::npos;)
     message.replace(at, staging_dir.size(), out.string());
   return message;
+}
+
+// Rank 0 of a split run, or the only process: runs and reports the scene. Returns the exit status.
+int run_reporting(const Scene& scene, bool quiet, Collective* group) {
+  std::string staging_dir;
+  try {
+    return run_staged(scene, quiet, staging_dir, group);
+  } catch (const std::bad_alloc&) {
+    std::cerr << "validate-geometry: error: out of memory for " << scene.ensemble.sphere.asperities << " asperities x "
+              << scene.ensemble.drops << " drops (" << to_string(scene.ensemble.mode) << " mode); "
+              << scene.out.string() << " is as it was\n";
+    return 2;
+  } catch (const std::exception& ex) {
+    std::cerr << "validate-geometry: error: " << in_place(ex.what(), staging_dir, scene.out) << "\n";
+    return 2;
+  }
+}
+
+// A split run's collective steps, counted so that rank 0 completes them when it fails early: the
+// other processes wait for exactly these (read_command_line's agreement, the stream's outcome, the
+// gather when it succeeded, the exit status).
+class CountedSteps final : public Collective {
+ public:
+  explicit CountedSteps(Collective& g) : g_(g) {}
+  int rank() const override { return g_.rank(); }
+  int size() const override { return g_.size(); }
+  int max(int v) override { return ++steps, g_.max(v); }
+  std::vector<std::string> gather(const std::string& b) override { return ++steps, g_.gather(b); }
+  int steps = 0;
+
+ private:
+  Collective& g_;
+};
+
+// The processes of a split run: rank 0 reports (a scene that does not stream runs on rank 0 alone),
+// the others run their share of the stream; all end with rank 0's exit status.
+int run_split(const Scene& scene, bool quiet, Collective& world) {
+  CountedSteps group(world);
+  const bool split = scene.share.ranks > 1;
+  int status = 0;
+  if (group.rank() == 0) {
+    if (!split)
+      std::cerr << "validate-geometry: note: this scene does not stream (statistics = raw, or not a contact ensemble): "
+                   "rank 0 runs it alone (--statistics streaming splits a contact ensemble across the processes)\n";
+    status = run_reporting(scene, quiet, split ? &group : nullptr);
+    // Failed before the stream's outcome was agreed: take part in it, as failed.
+    if (split && group.steps == 0) group.max(2);
+  } else if (split) {
+    try {
+      run_stream_share(scene, group);
+    } catch (const std::exception& ex) {
+      const std::string what = ex.what();
+      if (what.find("another process") == std::string::npos && what.find("stopped before") == std::string::npos)
+        std::cerr << "validate-geometry: error (rank " << group.rank() << "): " << what << "\n";
+      status = 2;
+    }
+  }
+  return group.max(group.rank() == 0 ? status : 0);
 }
 
 }  // namespace
@@ -125,20 +189,33 @@ int main(int argc, char** argv) {
   // memory in again (halved the index stage of fig3 on the loaded 2-core machine; bench/RESULTS.md).
   mallopt(M_MMAP_THRESHOLD, 256 << 20);
   mallopt(M_TRIM_THRESHOLD, 512 << 20);
-  Scene scene;
-  bool quiet = false;
-  // Everything that can be checked is checked before the output directory is touched.
-  if (const auto status = read_command_line(argc, argv, scene, quiet)) return *status;
-  std::string staging_dir;
+  std::unique_ptr<Collective> world;
   try {
-    return run_staged(scene, quiet, staging_dir);
-  } catch (const std::bad_alloc&) {
-    std::cerr << "validate-geometry: error: out of memory for " << scene.ensemble.sphere.asperities << " asperities x "
-              << scene.ensemble.drops << " drops (" << to_string(scene.ensemble.mode) << " mode); "
-              << scene.out.string() << " is as it was\n";
-    return 2;
+    world = cli::join_processes(&argc, &argv);
   } catch (const std::exception& ex) {
-    std::cerr << "validate-geometry: error: " << in_place(ex.what(), staging_dir, scene.out) << "\n";
+    std::cerr << "validate-geometry: error: " << ex.what() << "\n";
     return 2;
   }
+  const StreamShare share = world ? StreamShare{world->rank(), world->size()} : StreamShare{};
+  Scene scene;
+  bool quiet = false;
+  // Everything that can be checked is checked before the output directory is touched (by every
+  // process: each checks its own checkpoint file; all stop when one finds a fault).
+  std::string error;
+  const std::optional<int> status = read_command_line(argc, argv, scene, quiet, share, error);
+  if (world && world->max(status ? (*status == 0 ? 1 : 2) : 0) != 0) {
+    // One message: rank 0's, or (when only other processes refused, e.g. a missing checkpoint of
+    // theirs) each of theirs.
+    const bool rank0_failed = world->max(share.rank == 0 && !error.empty()) != 0;
+    if (!error.empty() && (share.rank == 0 || !rank0_failed))
+      std::cerr << "validate-geometry: error" << (share.rank > 0 ? " (rank " + std::to_string(share.rank) + ")" : "")
+                << ": " << error << "\n";
+    return status && *status == 0 ? 0 : 2;
+  }
+  if (status) {
+    if (!error.empty()) std::cerr << "validate-geometry: error: " << error << "\n";
+    return *status;
+  }
+  if (world) return run_split(scene, quiet, *world);
+  return run_reporting(scene, quiet, nullptr);
 }

@@ -1,0 +1,111 @@
+#include "app/cli/processes.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#if ASPERITY_WITH_MPI
+#include <mpi.h>
+#endif
+
+namespace asperity::cli {
+
+namespace {
+
+// What MPI launchers put into the environment: the world size, or this process's rank (PMIx).
+long env_number(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? std::strtol(v, nullptr, 10) : -1;
+}
+[[maybe_unused]] bool launched_as_one_of_many() {
+  return env_number("OMPI_COMM_WORLD_SIZE") > 1 || env_number("PMI_SIZE") > 1 || env_number("PMIX_RANK") > 0 ||
+         env_number("PMI_RANK") > 0;
+}
+bool launched_by_mpi() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "PMI_RANK"})
+    if (std::getenv(v)) return true;
+  return false;
+}
+
+#if ASPERITY_WITH_MPI
+// Waits for a non-blocking collective by polling with short sleeps: a blocking MPI call spins on a
+// core, and ranks > 0 wait for rank 0 for the whole of its analysis (or of a run that does not split).
+void wait(MPI_Request& req) {
+  for (int done = 0;;) {
+    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+}
+
+class MpiCollective final : public Collective {
+ public:
+  MpiCollective() {
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+  }
+  ~MpiCollective() override { MPI_Finalize(); }
+  int rank() const override { return rank_; }
+  int size() const override { return size_; }
+  int max(int v) override {
+    int out = v;
+    MPI_Request req;
+    MPI_Iallreduce(&v, &out, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &req);
+    wait(req);
+    return out;
+  }
+  // Sizes first (64-bit: a share's histograms can pass 2 GiB only at 2^24 bins x 3 x 256 blocks,
+  // refused here rather than truncated), then the bytes.
+  std::vector<std::string> gather(const std::string& bytes) override {
+    if (bytes.size() > std::size_t(1) << 31) throw std::runtime_error("a share of more than 2 GiB cannot be sent");
+    const int n = static_cast<int>(bytes.size());
+    std::vector<int> sizes(rank_ == 0 ? std::size_t(size_) : 0);
+    MPI_Request req;
+    MPI_Igather(&n, 1, MPI_INT, sizes.data(), 1, MPI_INT, 0, MPI_COMM_WORLD, &req);
+    wait(req);
+    std::vector<int> at(sizes.size(), 0);
+    long total = 0;
+    for (std::size_t r = 0; r < sizes.size(); ++r) {
+      at[r] = static_cast<int>(total);
+      total += sizes[r];
+    }
+    if (total > (1L << 31) - 1) throw std::runtime_error("the shares of all processes exceed 2 GiB");
+    std::string all(std::size_t(total), '\0');
+    MPI_Igatherv(bytes.data(), n, MPI_CHAR, all.data(), sizes.data(), at.data(), MPI_CHAR, 0, MPI_COMM_WORLD, &req);
+    wait(req);
+    std::vector<std::string> parts;
+    for (std::size_t r = 0; r < sizes.size(); ++r) parts.push_back(all.substr(std::size_t(at[r]), std::size_t(sizes[r])));
+    return parts;
+  }
+
+ private:
+  int rank_ = 0, size_ = 1;
+};
+#endif
+
+}  // namespace
+
+std::unique_ptr<Collective> join_processes(int* argc, char*** argv) {
+  if (!launched_by_mpi()) return nullptr;
+#if ASPERITY_WITH_MPI
+  int provided = 0;
+  // FUNNELED: only the main thread calls MPI (OpenMP threads never do).
+  MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+  auto group = std::make_unique<MpiCollective>();
+  if (group->size() == 1) return nullptr;  // mpirun -np 1: one process (MPI_Finalize by the destructor)
+  return group;
+#else
+  (void)argc, (void)argv;
+  if (launched_as_one_of_many())
+    throw std::runtime_error(
+        "started by an MPI launcher as one of several processes, but this validate-geometry was built without MPI "
+        "(install libopenmpi-dev and rebuild; README \"Beyond one machine\"): each process would run the whole scene "
+        "into the same directory");
+  return nullptr;
+#endif
+}
+
+}  // namespace asperity::cli
