@@ -25,7 +25,7 @@ execute_process(COMMAND ${CMAKE_COMMAND} -E env ASPERITY_CONFIGURE_ONLY=${WORK_D
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "scripts/test's configure failed: ${err}")
 endif()
-foreach(option ASPERITY_BUILD_TESTS ASPERITY_BUILD_BENCH ASPERITY_BUILD_CLI)
+foreach(option ASPERITY_BUILD_TESTS ASPERITY_BUILD_BENCH ASPERITY_BUILD_CLI ASPERITY_WITH_MPI)
   file(STRINGS ${WORK_DIR}/CMakeCache.txt line REGEX "^${option}:")
   if(NOT line MATCHES "=ON$")
     message(FATAL_ERROR "after scripts/run, scripts/test leaves ${option} off: ${line}")

@@ -116,3 +116,34 @@ TEST(Streaming, AutomaticStatisticsStreamOnlyLargeContactRuns) {
   EXPECT_EQ(parse_statistics("streaming"), Statistics::streaming);
   EXPECT_THROW(parse_statistics("fast"), std::invalid_argument);
 }
+
+// A run split across P processes (validate-geometry under mpirun): the shares tile the run's units
+// in whole blocks of spheres, and merging them, in any order, gives the bits of one process's run.
+TEST(Streaming, SharesMergeToTheSameBitsAsOneProcess) {
+  // G = K blocks of one sphere; G = 256 blocks of several spheres; big spheres (K < P for P = 3, 5:
+  // some processes have nothing to do); sampled drops.
+  for (const auto& c : {config(Mode::explicit_spheres, 64, 64 * 300), config(Mode::explicit_spheres, 600, 600 * 40),
+                        config(Mode::explicit_spheres, 2, 2 * 80000), config(Mode::sampled, 1, 50000)}) {
+    const StreamState whole = run(c, 2);
+    for (int P : {2, 3, 5}) {
+      std::vector<StreamState> parts;
+      std::uint64_t next = 0, drops = 0;
+      for (int r = 0; r < P; ++r) {
+        const auto [u0, u1] = share_units(c, {r, P});
+        EXPECT_EQ(u0, next) << "shares tile the units in order";
+        next = u1;
+        drops += share_drops(c, {r, P});
+        EnsembleConfig one = c;
+        one.threads = 1 + r % 2;
+        parts.push_back(run_contact_stream(one, {}, {}, nullptr, {r, P}).state);
+      }
+      EXPECT_EQ(drops, c.drops);
+      StreamState forward = parts[0], backward = parts[std::size_t(P - 1)];
+      for (int r = 1; r < P; ++r) merge_shares(forward, parts[std::size_t(r)]);
+      for (int r = P - 2; r >= 0; --r) merge_shares(backward, parts[std::size_t(r)]);
+      EXPECT_TRUE(forward == whole) << to_string(c.mode) << " K = " << c.spheres << ", P = " << P;
+      EXPECT_TRUE(backward == whole) << to_string(c.mode) << " K = " << c.spheres << ", P = " << P;
+    }
+  }
+  EXPECT_THROW(share_units(config(Mode::sampled, 1, 100), {2, 2}), std::invalid_argument);
+}
