@@ -6,6 +6,7 @@
 #include <chrono>
 #include <stdexcept>
 #include <cmath>
+#include <cstring>
 #include <iomanip>
 #include <limits>
 #include <iostream>
@@ -246,16 +247,54 @@ void write_band_png(const std::filesystem::path& png, const BandFigure& fig) {
 
 namespace {
 
-// Rank 0 receives every share and merges them (disjoint blocks: the same bits as one process);
-// the others send theirs. Timings stay rank 0's own.
-void gather_shares(const Scene& s, ContactStream& cs, Collective& group) {
-  const std::vector<std::string> parts = group.gather(stream_state_bytes(s, cs.state));
-  for (std::size_t r = 1; r < parts.size(); ++r)
-    merge_shares(cs.state, stream_state_from_bytes(parts[r], s, "the share of rank " + std::to_string(r)));
+// What a share sends besides its histograms: the block moments (each block is one process's) and
+// the counters, a few kB.
+std::string share_summary(const StreamState& st) {
+  std::string out;
+  auto put = [&](const auto& v) { out.append(reinterpret_cast<const char*>(&v), sizeof v); };
+  put(st.core_contacts), put(st.check_queries), put(st.check_agreed), put(st.index_bytes);
+  for (const auto& b : st.stats)
+    for (const Moments& m : b.block_moments) put(m);
+  return out;
+}
+
+// Adds a share's summary to `into` as merge_shares would (its histograms are summed separately).
+void merge_summary(StreamState& into, const std::string& bytes, int rank) {
+  std::size_t at = 0;
+  auto get = [&](auto& v) {
+    if (bytes.size() - at < sizeof v) throw std::runtime_error("the share of rank " + std::to_string(rank) + " is truncated");
+    std::memcpy(&v, bytes.data() + at, sizeof v);
+    at += sizeof v;
+  };
+  std::uint64_t core = 0, queries = 0, agreed = 0, index = 0;
+  get(core), get(queries), get(agreed), get(index);
+  into.core_contacts += core, into.check_queries += queries, into.check_agreed += agreed;
+  into.index_bytes = std::max(into.index_bytes, index);
+  for (auto& b : into.stats)
+    for (Moments& m : b.block_moments) {
+      Moments o;
+      get(o);
+      m.merge(o);
+    }
+  if (at != bytes.size()) throw std::runtime_error("the share of rank " + std::to_string(rank) + " has trailing bytes");
+}
+
+// Rank 0 receives every share and merges it into its own: the histograms are summed (integers),
+// the block moments merged (disjoint blocks: the same bits as one process), the counters added.
+// Timings stay rank 0's own.
+void gather_shares(ContactStream& cs, Collective& group) {
+  StreamState& st = cs.state;
+  const std::vector<std::string> parts = group.gather(share_summary(st));
+  for (auto& b : st.stats) {
+    group.sum(b.fine);
+    group.sum(b.coarse);
+  }
   if (group.rank() != 0) return;
+  // The summed histograms are already in st; merge_summary adds only moments and counters.
+  for (std::size_t r = 1; r < parts.size(); ++r) merge_summary(st, parts[r], int(r));
   cs.complete = true;
-  cs.index_bytes = static_cast<std::size_t>(cs.state.index_bytes);
-  cs.cross_check.queries = cs.state.check_queries, cs.cross_check.agreed = cs.state.check_agreed;
+  cs.index_bytes = static_cast<std::size_t>(st.index_bytes);
+  cs.cross_check.queries = st.check_queries, cs.cross_check.agreed = st.check_agreed;
 }
 
 // The stream of `run` (the planned ensemble of scene s), or of this process's share s.share, with
@@ -307,7 +346,7 @@ ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run,
     defer.reset();  // a pending signal ends the process here
     throw std::runtime_error("the streaming run stopped before its last drop; checkpoint in " + where);
   }
-  if (group) gather_shares(s, cs, *group);
+  if (group) gather_shares(cs, *group);
   return cs;
 }
 }  // namespace

@@ -1,5 +1,6 @@
 #include "app/cli/processes.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <stdexcept>
@@ -57,8 +58,7 @@ class MpiCollective final : public Collective {
     wait(req);
     return out;
   }
-  // Sizes first (64-bit: a share's histograms can pass 2 GiB only at 2^24 bins x 3 x 256 blocks,
-  // refused here rather than truncated), then the bytes.
+  // Sizes first, then the bytes (small: block moments and counters, not the histograms).
   std::vector<std::string> gather(const std::string& bytes) override {
     if (bytes.size() > std::size_t(1) << 31) throw std::runtime_error("a share of more than 2 GiB cannot be sent");
     const int n = static_cast<int>(bytes.size());
@@ -79,6 +79,19 @@ class MpiCollective final : public Collective {
     std::vector<std::string> parts;
     for (std::size_t r = 0; r < sizes.size(); ++r) parts.push_back(all.substr(std::size_t(at[r]), std::size_t(sizes[r])));
     return parts;
+  }
+  // In pieces of at most 2^24 counts (MPI counts are int; 2^24 keeps the temporary buffers small).
+  void sum(std::vector<std::uint64_t>& v) override {
+    constexpr std::size_t kPiece = std::size_t{1} << 24;
+    for (std::size_t at = 0; at < v.size(); at += kPiece) {
+      const int n = static_cast<int>(std::min(kPiece, v.size() - at));
+      MPI_Request req;
+      if (rank_ == 0)
+        MPI_Ireduce(MPI_IN_PLACE, v.data() + at, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD, &req);
+      else
+        MPI_Ireduce(v.data() + at, nullptr, n, MPI_UINT64_T, MPI_SUM, 0, MPI_COMM_WORLD, &req);
+      wait(req);
+    }
   }
 
  private:

@@ -138,7 +138,7 @@ int run_reporting(const Scene& scene, bool quiet, Collective* group) {
 
 // A split run's collective steps, counted so that rank 0 completes them when it fails early: the
 // other processes wait for exactly these (read_command_line's agreement, the stream's outcome, the
-// gather when it succeeded, the exit status).
+// gather and sums when it succeeded, the exit status).
 class CountedSteps final : public Collective {
  public:
   explicit CountedSteps(Collective& g) : g_(g) {}
@@ -146,6 +146,7 @@ class CountedSteps final : public Collective {
   int size() const override { return g_.size(); }
   int max(int v) override { return ++steps, g_.max(v); }
   std::vector<std::string> gather(const std::string& b) override { return ++steps, g_.gather(b); }
+  void sum(std::vector<std::uint64_t>& v) override { ++steps, g_.sum(v); }
   int steps = 0;
 
  private:
