@@ -14,7 +14,11 @@ namespace asperity {
 
 namespace {
 
-constexpr char kMagic[] = "asperity-stream-checkpoint-1\n";
+// Version 2 adds a byte-order mark after the magic: a checkpoint carried to a machine of the other
+// byte order is refused by name instead of read as garbage. Version 1 (no mark) is still read.
+constexpr char kMagic[] = "asperity-stream-checkpoint-2\n";
+constexpr char kMagicV1[] = "asperity-stream-checkpoint-1\n";
+constexpr std::uint32_t kByteOrderMark = 0x01020304;
 
 template <class T>
 void put(std::string& out, const T& v) {
@@ -70,6 +74,7 @@ struct Reader {
 
 std::string serialise(const std::string& key, const StreamState& st) {
   std::string out(kMagic);
+  put(out, kByteOrderMark);
   put_text(out, key);
   put(out, st.next_unit), put(out, st.core_contacts), put(out, st.check_queries), put(out, st.check_agreed);
   put(out, st.index_bytes);
@@ -123,8 +128,12 @@ StreamState read_checkpoint(const std::filesystem::path& dir, const Scene& s) {
 StreamState stream_state_from_bytes(const std::string& in, const Scene& s, const std::string& what) {
   Reader r{in, 0, what};
   r.need(sizeof kMagic - 1);
-  if (in.compare(0, sizeof kMagic - 1, kMagic) != 0) throw std::invalid_argument(what + ": not a checkpoint of this version");
+  const bool v2 = in.compare(0, sizeof kMagic - 1, kMagic) == 0;
+  if (!v2 && in.compare(0, sizeof kMagicV1 - 1, kMagicV1) != 0)
+    throw std::invalid_argument(what + ": not a checkpoint of this version");
   r.at = sizeof kMagic - 1;
+  if (v2 && r.get<std::uint32_t>() != kByteOrderMark)
+    throw std::invalid_argument(what + ": written on a machine of another byte order (or damaged); resume it there");
   if (r.text() != checkpoint_key(s))
     throw std::invalid_argument(what + ": written for another scene than " + kCheckpointScene +
                                 " with these options (only --threads, --quiet, --no-plots and --checkpoint-every may change)");

@@ -106,12 +106,19 @@ TEST(Checkpoint, DamagedOrForeignCheckpointsAreRefused) {
   // No checkpoint at all; then a file that is not one.
   auto r = run_command(vg() + " --resume " + dir.string() + " 2>&1");
   EXPECT_EQ(r.status, 2) << r.out;
-  std::ofstream(dir / "checkpoint.toml") << "name = \"x\"\n[ensemble]\ndrops = 4000\nstatistics = \"streaming\"\n";
-  std::ofstream(dir / "checkpoint.bin") << "not a checkpoint";
+  std::ofstream(dir / "checkpoint.toml") << "format = 1\nname = \"x\"\n[ensemble]\ndrops = 4000\nstatistics = \"streaming\"\n";
+  std::ofstream(dir / "checkpoint.bin") << "not a checkpoint, though longer than the magic line";
   r = run_command(vg() + " -q --no-plots --resume " + dir.string() + " 2>&1");
   EXPECT_EQ(r.status, 2) << r.out;
-  EXPECT_NE(r.out.find("checkpoint"), std::string::npos) << r.out;
-  EXPECT_EQ(slurp(dir / "checkpoint.bin"), "not a checkpoint") << "a refused checkpoint is left as it was";
+  EXPECT_NE(r.out.find("checkpoint.bin: not a checkpoint of this version"), std::string::npos) << r.out;
+  EXPECT_EQ(slurp(dir / "checkpoint.bin"), "not a checkpoint, though longer than the magic line")
+      << "a refused checkpoint is left as it was";
+  // A checkpoint from a machine of the other byte order: its mark reads 0x04030201 here.
+  std::ofstream(dir / "checkpoint.bin", std::ios::binary) << "asperity-stream-checkpoint-2\n" << std::string("\x01\x02\x03\x04", 4)
+                                                          << std::string(64, '\0');
+  r = run_command(vg() + " -q --no-plots --resume " + dir.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("byte order"), std::string::npos) << r.out;
   fs::remove_all(dir);
 }
 

@@ -2,7 +2,8 @@
 // Checkpoints of a streaming run (issue 14, item 4): the statistics so far, where to continue and
 // the scene, in the run's output directory, written atomically (write_file_atomic):
 //   checkpoint.toml  the scene (to_toml; `validate-geometry --resume DIR` runs it again)
-//   checkpoint.bin   the StreamState (binary, this machine's byte order) and the scene's key
+//   checkpoint.bin   the StreamState (binary, this machine's byte order, marked: another order is
+//                    refused) and the scene's key
 // A run split across P > 1 processes (validate-geometry under mpirun) writes one state per process,
 // checkpoint.rank-R-of-P.bin, each holding that process's share (experiments/streaming.hpp); it is
 // resumed with the same P.
