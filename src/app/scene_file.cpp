@@ -244,7 +244,6 @@ class Reader {
   std::set<std::string> used_;
 };
 
-constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;              // ensemble.hpp
 
 // [outputs.cor_table]: file (required), speeds, probabilities, drops, spins, omega_bands. The names are checked against
 // the run's other outputs by validate(Scene); the table's own ranges here, each key named.
@@ -263,7 +262,7 @@ CorTableScene read_cor_table(Reader& t) {
     c.speeds = *v;
   }
   if (auto p = t.count("probabilities", 2, 100001)) c.probabilities = *p;
-  if (auto d = t.count("drops", 3, kMaxDrops)) c.drops = *d;
+  if (auto d = t.count("drops", 3, kMaxRawDrops)) c.drops = *d;
   if (auto w = t.reals("spins")) {
     for (std::size_t i = 0; i < w->size(); ++i) {
       if (std::abs((*w)[i]) > 1e6) t.bad("spins", "each |spin| must be <= 1e6 rad/s, got " + num((*w)[i]));
@@ -528,7 +527,7 @@ void read_spheres(Reader& ens, Scene& s) {
   const toml::node* k_node = ens.has("spheres") ? ens.find("spheres") : nullptr;
   if (k_node && k_node->as_string() && k_node->as_string()->get() == "auto") {
     s.spheres_auto = true;
-  } else if (auto k = ens.count("spheres", 1, kMaxDrops)) {
+  } else if (auto k = ens.count("spheres", 1, kMaxRawDrops)) {
     if (e.mode == Mode::sampled && *k != 1)
       ens.bad("spheres", "only mode = \"explicit\" uses explicit spheres (sampled draws from the exact law, no sphere), "
                          "got " + std::to_string(*k));
@@ -610,7 +609,7 @@ void read_screening(Reader& top, Scene& s) {
       scr->fail(nullptr, "screening", "screening: only for unequal asperity radii (asperities.radius distribution "
                                       "\"levels\" or \"lognormal\")");
     if (auto b = scr->count("bodies", 1, 1u << 20)) s.radii->screen_bodies = *b;
-    if (auto d = scr->count("directions", 1, kMaxDrops)) s.radii->screen_directions = *d;
+    if (auto d = scr->count("directions", 1, kMaxRawDrops)) s.radii->screen_directions = *d;
     scr->finish();
   }
   if (s.radii && !s.mesh && s.radii->radii.kind == RadiusDistribution::Kind::lognormal &&

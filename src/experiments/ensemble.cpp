@@ -90,7 +90,7 @@ void validate(const EnsembleConfig& c) {
   if (uses_streaming(c) && c.drops > kMaxStreamingDrops)
     throw std::invalid_argument("drops must be <= 2^50 for streaming statistics, got " + std::to_string(c.drops));
   // Beyond 2^31 only when streaming was asked for: a run of that size is a decision, never automatic.
-  if (c.statistics != Statistics::streaming && c.drops > (std::uint64_t{1} << 31))
+  if (c.statistics != Statistics::streaming && c.drops > kMaxRawDrops)
     throw std::invalid_argument("drops must be <= 2^31 unless statistics = streaming (--statistics streaming), got " +
                                 std::to_string(c.drops));
   if (c.mode == Mode::explicit_spheres) {

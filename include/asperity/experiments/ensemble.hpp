@@ -98,6 +98,9 @@ std::string_view to_string(Statistics s);
 Statistics parse_statistics(std::string_view s);
 /// Above this many drops an automatic run streams (raw samples would take ~2 GiB).
 inline constexpr std::uint64_t kStreamingAutoDrops = std::uint64_t{1} << 25;
+/// Most drops of a run that keeps raw samples, and most spheres, bounce sequences or table drops a
+/// scene or the command line may ask for (per-item arrays are indexed and sized in 2^31).
+inline constexpr std::uint64_t kMaxRawDrops = std::uint64_t{1} << 31;
 /// Most drops of a streaming run (the counters are 64-bit; 2^50 is ~10^15). Beyond 2^31 drops only
 /// when statistics = streaming was asked for (validate).
 inline constexpr std::uint64_t kMaxStreamingDrops = std::uint64_t{1} << 50;

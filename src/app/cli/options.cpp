@@ -20,7 +20,6 @@ namespace asperity::cli {
 
 namespace {
 
-constexpr std::uint64_t kMaxDrops = std::uint64_t{1} << 31;  // ensemble.hpp (kMaxAsperities: geometry.hpp, the one N < 2^32 rule)
 
 bool digits(const std::string& t, std::size_t& i) {
   const std::size_t from = i;
@@ -284,7 +283,7 @@ void apply_design_options(Scene& scene, const RawOptions& r, const Given& given,
   }
   if (given("--mode")) apply_mode_option(scene, r, given, k);
   if (given("--spheres")) {
-    e.spheres = parse_count("--spheres", r.spheres, 1, kMaxDrops);
+    e.spheres = parse_count("--spheres", r.spheres, 1, kMaxRawDrops);
     scene.spheres_auto = false;
     if ((k.bounce && !k.mesh) || k.radii)
       refuse("--spheres", "not used by " + k.text + (k.radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
@@ -354,7 +353,7 @@ void apply_bounce_options(Scene& scene, const RawOptions& r, const Given& given)
   if (!scene.bounce.enabled) return;
   auto& e = scene.ensemble;
   if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
-  if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", r.sequences, 1, kMaxDrops);
+  if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", r.sequences, 1, kMaxRawDrops);
   if (given("--variant")) scene.bounce.variants = parse_variants(r.variants);
 }
 
