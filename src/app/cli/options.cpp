@@ -20,7 +20,6 @@ namespace asperity::cli {
 
 namespace {
 
-
 bool digits(const std::string& t, std::size_t& i) {
   const std::size_t from = i;
   while (i < t.size() && t[i] >= '0' && t[i] <= '9') ++i;
