@@ -15,6 +15,7 @@
 #include "app/cli/options.hpp"
 #include "asperity/app/resources.hpp"
 #include "run_command.hpp"
+#include "sanitized.hpp"
 
 namespace fs = std::filesystem;
 
@@ -43,13 +44,6 @@ double measured_peak(const std::vector<std::string>& args, const fs::path& out, 
 
 // A sanitized validate-geometry measures the sanitizer's shadow memory and quarantine, not the
 // costs the estimate models: the comparison is made in uninstrumented builds only.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define ASPERITY_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
-#define ASPERITY_SANITIZED 1
-#endif
-#endif
 
 TEST(Resources, EstimateWithin25PercentOfTheMeasuredPeak) {
 #ifdef ASPERITY_SANITIZED

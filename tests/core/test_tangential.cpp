@@ -4,6 +4,8 @@
 // the kinematic and Newton laws -- on spheres, ellipsoids and cube-like bodies (corner contacts).
 #include <gtest/gtest.h>
 
+#include "sanitized.hpp"
+
 #include <Eigen/Geometry>
 
 #include <cmath>
@@ -241,11 +243,7 @@ TEST(Tangential, RestitutionRulesHoldAndWorkEqualsEnergyChange) {
 
 // Random impacts per shape: 3000 (1000 under the sanitizers, where each solve costs ~15x: the sweep
 // would take a minute of the CI's ASan pass; the Release pass runs the full 3000).
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr std::uint64_t kDefaultCases = 1000;
-#else
-constexpr std::uint64_t kDefaultCases = 3000;
-#endif
+constexpr std::uint64_t kDefaultCases = asperity::testing::kSanitized ? 1000 : 3000;
 
 TEST(Tangential, StrongeNeverCreatesEnergyTheKinematicLawDoes) {
   // 3000 random impacts per shape (sphere, ellipsoid, cube corner), e in [0, 1], mu in [0, 1.5],

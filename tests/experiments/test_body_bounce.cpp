@@ -3,6 +3,8 @@
 // sphere's first impacts against the corrected Eq. 28, thread-count independence.
 #include <gtest/gtest.h>
 
+#include "sanitized.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -211,16 +213,20 @@ TEST(BodyBounce, LandingMatchesBruteScanAndOptimisticBoundMisses) {
 TEST(BodyBounce, RoughSphereFirstImpactFollowsEq28) {
   SphereParams p;
   p.asperities = 100000, p.radius = 3e-3, p.asperity_radius = 6.5e-7;
+  // Under the sanitizers: 4 bodies and 800 first impacts check memory on the same paths; the law
+  // and its power are asserted in Release (16 bodies, 16000 impacts).
+  const bool full = !asperity::testing::kSanitized;
   std::vector<RoughBody> bodies;
-  for (std::uint64_t k = 0; k < 16; ++k) bodies.push_back(make_rough_sphere_body(p, RadiusDistribution::fixed(6.5e-7), 9, k));
+  for (std::uint64_t k = 0; k < (full ? 16u : 4u); ++k)
+    bodies.push_back(make_rough_sphere_body(p, RadiusDistribution::fixed(6.5e-7), 9, k));
   BodyBounceOptions o;
   o.bounce.variants = {BounceVariant::dynamic};
-  o.bounce.sequences = 16000;
+  o.bounce.sequences = full ? 16000 : 800;
   o.bounce.speed = 1.3;
   o.bounce.max_impacts = 1;
   o.bounce.omega = Vec3(0.2, 0, 0);
   const BodyBounceSamples s = run_body_bounces(bodies, o, 21, 2);
-  ASSERT_EQ(s.base.eps.size(), 16000u);
+  ASSERT_EQ(s.base.eps.size(), o.bounce.sequences);
   auto eps = s.base.eps;
   std::sort(eps.begin(), eps.end());
   ImpactScene sc;
@@ -229,8 +235,10 @@ TEST(BodyBounce, RoughSphereFirstImpactFollowsEq28) {
   const KsResult bad = ks_one_sample(eps, eq28_corrected(sc, 1.05).cdf);
   std::cerr << "Eq. 28 corrected: D = " << good.D << ", p = " << good.p << "; alpha x 1.05: D = " << bad.D << ", p = " << bad.p
             << "\n";
-  EXPECT_GT(good.p, 0.01) << "D = " << good.D;
-  EXPECT_LT(bad.p, 0.01) << "D = " << bad.D;
+  if (full) {
+    EXPECT_GT(good.p, 0.01) << "D = " << good.D;
+    EXPECT_LT(bad.p, 0.01) << "D = " << bad.D;
+  }
 
   o.bounce.sequences = 40, o.bounce.max_impacts = 3;
   const BodyBounceSamples f = run_body_bounces(bodies, o, 22, 2);
