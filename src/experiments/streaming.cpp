@@ -33,27 +33,53 @@ struct Slot {
   std::uint64_t core = 0;
 };
 
-// What the threads of a wave write into: coarse counts atomically (integers: any order), fine
-// counts into their own histograms (folded into the state between waves), moments into their slot.
+// What the threads of a wave write into: fine counts into their own histograms (folded into the
+// state at checkpoints and at the end), coarse counts of their current block into their own cells
+// (added atomically -- integers: any order -- when the block changes and at fold()), moments into
+// their slot. So a drop costs no atomic operation and no transcendental function.
 struct Sink {
+  static constexpr std::size_t kNoBlock = ~std::size_t{0};
   std::vector<BinnedStats>& stats;
+  std::vector<const FineBinner*> bin;            // per quantity
   std::vector<std::vector<std::uint64_t>> fine;  // thread t, quantity q at t * kQ + q
+  std::vector<std::vector<std::uint64_t>> cell;  // thread t: quantity q's coarse bin c at q C + c
+  std::vector<std::size_t> cell_block;           // thread t: the block its cells count, or kNoBlock
   std::uint64_t K = 0, G = 0;
   std::size_t block(std::uint64_t k) const { return static_cast<std::size_t>(k * G / K); }
 
+  Sink(std::vector<BinnedStats>& s, std::vector<const FineBinner*> b, std::size_t threads, std::uint64_t spheres)
+      : stats(s), bin(std::move(b)), fine(threads * kQ, std::vector<std::uint64_t>(s[0].fine_bins(), 0)),
+        cell(threads, std::vector<std::uint64_t>(kQ * s[0].coarse_bins(), 0)), cell_block(threads, kNoBlock),
+        K(spheres), G(s[0].blocks) {}
+
   void count(int t, std::size_t g, const Contact& ct, Slot& slot) {
+    const auto ti = static_cast<std::size_t>(t);
+    if (cell_block[ti] != g) flush(ti), cell_block[ti] = g;
+    std::uint64_t* cells = cell[ti].data();
+    const unsigned shift = stats[0].fine_log2 - stats[0].coarse_log2;
+    const std::size_t C = stats[0].coarse_bins();
     const double x[kQ] = {ct.r_xy, ct.r.x(), ct.r.y()};
     for (std::size_t q = 0; q < kQ; ++q) {
-      BinnedStats& s = stats[q];
-      const std::size_t f = s.fine_bin(s.ref.cdf(x[q]));
-      ++fine[static_cast<std::size_t>(t) * kQ + q][f];
-      std::atomic_ref<std::uint64_t>(s.coarse[g * s.coarse_bins() + (f >> (s.fine_log2 - s.coarse_log2))])
-          .fetch_add(1, std::memory_order_relaxed);
+      const std::size_t f = (*bin[q])(x[q]);
+      ++fine[ti * kQ + q][f];
+      ++cells[q * C + (f >> shift)];
       slot.m[q].add(x[q]);
     }
     slot.core += ct.core ? 1 : 0;
   }
+  void flush(std::size_t t) {
+    const std::size_t g = cell_block[t], C = stats[0].coarse_bins();
+    if (g == kNoBlock) return;
+    for (std::size_t q = 0; q < kQ; ++q)
+      for (std::size_t c = 0; c < C; ++c)
+        if (std::uint64_t& v = cell[t][q * C + c]; v != 0) {
+          std::atomic_ref<std::uint64_t>(stats[q].coarse[g * C + c]).fetch_add(v, std::memory_order_relaxed);
+          v = 0;
+        }
+    cell_block[t] = kNoBlock;
+  }
   void fold() {
+    for (std::size_t t = 0; t < cell.size(); ++t) flush(t);
     for (std::size_t i = 0; i < fine.size(); ++i) {
       auto& dst = stats[i % kQ].fine;
       for (std::size_t b = 0; b < dst.size(); ++b) dst[b] += fine[i][b];
@@ -202,8 +228,20 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
   const std::uint64_t K = sampled ? c.drops : c.spheres, m = sampled ? 1 : c.drops / c.spheres;
   const std::uint64_t us = (m + kUnit - 1) / kUnit, total_units = K * us;
   out.spheres = K, out.rotations = m;
-  Sink sink{st.stats, {}, K, st.stats[0].blocks};
-  sink.fine.assign(std::size_t(omp_get_max_threads()) * kQ, std::vector<std::uint64_t>(st.stats[0].fine_bins(), 0));
+  // One binner per distinct reference (r_x and r_y share theirs).
+  std::vector<FineBinner> binners;
+  std::vector<std::size_t> which;
+  for (std::size_t q = 0; q < kQ; ++q) {
+    std::size_t w = 0;
+    while (w < q && st.stats[w].ref != st.stats[q].ref) ++w;
+    if (w == q) w = binners.size(), binners.emplace_back(st.stats[q].ref, st.stats[q].fine_log2);
+    else w = which[w];
+    which.push_back(w);
+  }
+  std::vector<const FineBinner*> bin;
+  for (std::size_t w : which) bin.push_back(&binners[w]);
+  const auto threads = std::size_t(omp_get_max_threads());
+  Sink sink(st.stats, bin, threads, K);
   Driver dr{c, sink, sampled ? detail::CheckPlan{} : detail::check_plan(c), K, m, us};
   for (Backend b : dr.plan.others) out.cross_check.backends.emplace_back(to_string(b));
   const bool big = !sampled && us >= kBigSphereUnits;
@@ -241,8 +279,8 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
   st.index_bytes = std::max<std::uint64_t>(st.index_bytes, dr.bytes);
   out.index_bytes = static_cast<std::size_t>(st.index_bytes);
   out.cross_check.queries = st.check_queries, out.cross_check.agreed = st.check_agreed;
-  for (const auto& s : st.stats)
-    out.memory_bytes += (s.fine.size() * (1 + std::size_t(omp_get_max_threads())) + s.coarse.size()) * 8;
+  for (const auto& s : st.stats) out.memory_bytes += (s.fine.size() * (1 + threads) + s.coarse.size() + threads * s.coarse_bins()) * 8;
+  for (const auto& b : binners) out.memory_bytes += b.memory_bytes();
   return out;
 }
 

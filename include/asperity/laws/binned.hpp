@@ -52,6 +52,38 @@ struct Reference {
   friend bool operator==(const Reference&, const Reference&) = default;
 };
 
+/// The fine bin of a sample x, decided by the edges the binned tests use: bin j holds
+/// x_j <= x < x_(j+1) with x_j = ref.quantile(j 2^-k) (x_0 = -inf, x_(2^k) = +inf), the same doubles
+/// as binned_ks / binned_chi2 / to_block_bins evaluate their laws at. It agrees with
+/// fine_bin(ref.cdf(x)) except for x within rounding of an edge (where the cdf's rounding decided,
+/// the edge now does). Fast: a guess from the reference cdf tabulated on a fine x grid and
+/// interpolated (no transcendental function per sample), then exact comparisons with the edges, so
+/// the answer never depends on the guess's accuracy. Immutable after construction: share it.
+class FineBinner {
+ public:
+  /// Throws std::logic_error if the computed edges are not non-decreasing.
+  FineBinner(const Reference& ref, unsigned fine_log2);
+  std::size_t operator()(double x) const noexcept {
+    double t = (x - lo_) * inv_h_;
+    t = t > 0 ? t : 0;                                 // NaN too
+    t = t < tmax_ ? t : tmax_;
+    const auto i = static_cast<std::size_t>(t);
+    const double g = table_[i] + (t - double(i)) * (table_[i + 1] - table_[i]);
+    std::size_t k = g > 0 ? (g < double(last_) ? static_cast<std::size_t>(g) : last_) : 0;
+    const double* e = edge_.data();
+    while (k < last_ && x >= e[k + 1]) ++k;
+    while (k > 0 && x < e[k]) --k;
+    return k;
+  }
+  std::size_t memory_bytes() const noexcept { return (edge_.capacity() + table_.capacity()) * sizeof(double); }
+
+ private:
+  std::vector<double> edge_;   // x_0 .. x_(2^k)
+  std::vector<double> table_;  // 2^k ref.cdf at lo + i h, i = 0 .. kTable
+  double lo_ = 0, inv_h_ = 1, tmax_ = 0;
+  std::size_t last_ = 0;       // 2^k - 1
+};
+
 struct BinnedStats {
   Reference ref;
   unsigned fine_log2 = 16, coarse_log2 = 10;
