@@ -56,6 +56,13 @@ FineBinner::FineBinner(const Reference& ref, unsigned fine_log2) {
   table_.resize(kTable + 1);
   for (std::size_t i = 0; i <= kTable; ++i) table_[i] = ref.cdf(lo_ + double(i) * h) * double(B);
   last_ = B - 1;
+  // The shortcut needs g non-decreasing: the table must be (then g is, up to an ulp of g at a node,
+  // << the 1e-6 allowance below for any B <= 2^24), and g(x_j) within slack of j at every edge.
+  for (std::size_t i = 1; i <= kTable; ++i)
+    if (!(table_[i] >= table_[i - 1])) return;  // slack_ stays 1: always the comparisons
+  double worst = 0;
+  for (std::size_t j = 1; j < B; ++j) worst = std::max(worst, std::abs(guess(edge_[j]) - double(j)));
+  slack_ = std::min(1.0, worst + 1e-6);
 }
 
 std::string Reference::name() const {
