@@ -345,6 +345,11 @@ class Grid final : public ContactQuery {
     const double pa = p[a];
     const double p3 = std::abs(pa);
     if (!(p3 > 0)) return kNone;
+    // Most points are far outside two of their three candidate faces: skip those without the
+    // division. Conservative: |p_b| > S (1 + 1e-9) p3 makes the computed s = p_b (1 / p3) (two
+    // roundings of 2^-53) at least S in magnitude, outside [-S, S) as the test below would find.
+    const double out = S_ * (1.0 + 1e-9) * p3;
+    if (std::abs(p[(a + 1) % 3]) > out || std::abs(p[(a + 2) % 3]) > out) return kNone;
     const double r = 1.0 / p3;
     const double s = p[(a + 1) % 3] * r, t = p[(a + 2) % 3] * r;
     const double lo = edge_.front(), hi = edge_.back();
