@@ -269,7 +269,7 @@ class Grid final : public ContactQuery {
     if (out.size() != d.size()) throw std::invalid_argument("lowest(): output size differs from input size");
     // Software pipeline: query q is located (and its cell starts prefetched) at step q, its points
     // are prefetched at step q + kLag, and it is searched at step q + 2 kLag.
-    constexpr std::size_t kLag = 8, kRing = 2 * kLag + 1;
+    constexpr std::size_t kLag = 8, kRing = 32;  // >= 2 kLag + 1; a power of two: % is a mask
     std::array<Loc, kRing> loc;
     const std::size_t n = d.size();
     for (std::size_t step = 0; step < n + 2 * kLag; ++step) {
