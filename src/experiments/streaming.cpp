@@ -150,6 +150,25 @@ struct Driver {
   }
 };
 
+// One FineBinner per distinct reference (r_x and r_y share theirs) and, per quantity, its binner.
+struct Binners {
+  std::vector<FineBinner> distinct;
+  std::vector<const FineBinner*> per_quantity;
+  explicit Binners(const std::vector<BinnedStats>& stats) {
+    std::vector<std::size_t> which;
+    for (std::size_t q = 0; q < stats.size(); ++q) {
+      std::size_t w = 0;
+      while (w < q && stats[w].ref != stats[q].ref) ++w;
+      if (w == q) w = distinct.size(), distinct.emplace_back(stats[q].ref, stats[q].fine_log2);
+      else w = which[w];
+      which.push_back(w);
+    }
+    for (std::size_t w : which) per_quantity.push_back(&distinct[w]);  // distinct no longer grows
+  }
+  Binners(const Binners&) = delete;  // per_quantity points into distinct
+  Binners& operator=(const Binners&) = delete;
+};
+
 void merge_slots(StreamState& st, const Sink& sink, const std::vector<Slot>& slots, std::uint64_t first_unit,
                  std::uint64_t units_per_sphere) {
   for (std::size_t i = 0; i < slots.size(); ++i) {
@@ -235,20 +254,9 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
   const std::uint64_t K = sampled ? c.drops : c.spheres, m = sampled ? 1 : c.drops / c.spheres;
   const std::uint64_t us = (m + kUnit - 1) / kUnit, total_units = K * us;
   out.spheres = K, out.rotations = m;
-  // One binner per distinct reference (r_x and r_y share theirs).
-  std::vector<FineBinner> binners;
-  std::vector<std::size_t> which;
-  for (std::size_t q = 0; q < kQ; ++q) {
-    std::size_t w = 0;
-    while (w < q && st.stats[w].ref != st.stats[q].ref) ++w;
-    if (w == q) w = binners.size(), binners.emplace_back(st.stats[q].ref, st.stats[q].fine_log2);
-    else w = which[w];
-    which.push_back(w);
-  }
-  std::vector<const FineBinner*> bin;
-  for (std::size_t w : which) bin.push_back(&binners[w]);
+  const Binners binners(st.stats);
   const auto threads = std::size_t(omp_get_max_threads());
-  Sink sink(st.stats, bin, threads, K);
+  Sink sink(st.stats, binners.per_quantity, threads, K);
   Driver dr{c, sink, sampled ? detail::CheckPlan{} : detail::check_plan(c), K, m, us};
   for (Backend b : dr.plan.others) out.cross_check.backends.emplace_back(to_string(b));
   const bool big = !sampled && us >= kBigSphereUnits && (K < kFewSpheres || c.sphere.asperities > kHugeSphere || us > kLongSphereUnits);
@@ -291,7 +299,7 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
   out.index_bytes = static_cast<std::size_t>(st.index_bytes);
   out.cross_check.queries = st.check_queries, out.cross_check.agreed = st.check_agreed;
   for (const auto& s : st.stats) out.memory_bytes += (s.fine.size() * (1 + threads) + s.coarse.size() + threads * s.coarse_bins()) * 8;
-  for (const auto& b : binners) out.memory_bytes += b.memory_bytes();
+  for (const auto& b : binners.distinct) out.memory_bytes += b.memory_bytes();
   return out;
 }
 
