@@ -3,6 +3,7 @@
 // the wall time of run_contact_stream), per backend, with the raw-sample path (grid) as a ratio in
 // the same run. Median of --repeats runs; markdown on stdout (bench/RESULTS.md "Streaming").
 //   bench_streaming [--asperities N] [--drops n] [--brute-drops n] [--repeats r] [--threads t] [--quick]
+//                   [--grid-only | --raw-only]  (only the streaming grid / raw grid row: for profiling)
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -35,6 +36,7 @@ double timed(F f) {
 int main(int argc, char** argv) {
   std::uint64_t n = 10000, drops = 4000000, brute_drops = 200000;
   int repeats = 3, threads = 2;
+  bool grid_only = false, raw_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto next = [&] { return i + 1 < argc ? std::strtoull(argv[++i], nullptr, 10) : 0ull; };
@@ -43,6 +45,8 @@ int main(int argc, char** argv) {
     else if (a == "--brute-drops") brute_drops = next();
     else if (a == "--repeats") repeats = int(next());
     else if (a == "--threads") threads = int(next());
+    else if (a == "--grid-only") grid_only = true;
+    else if (a == "--raw-only") raw_only = true;
     else if (a == "--quick") n = 1000, drops = 100000, brute_drops = 20000, repeats = 1;
     else {
       std::fprintf(stderr, "unknown argument %s\n", a.c_str());
@@ -66,8 +70,10 @@ int main(int argc, char** argv) {
   };
   std::vector<Row> rows{{"streaming", Backend::grid, drops}, {"raw samples", Backend::grid, drops},
                         {"streaming", Backend::kdtree, drops}, {"streaming", Backend::brute, brute_drops}};
+  if (grid_only) rows.resize(1);
+  if (raw_only) rows.erase(rows.begin()), rows.resize(1);
 #if ASPERITY_WITH_FCL
-  rows.push_back({"streaming", Backend::fcl, drops / 4});
+  if (!grid_only && !raw_only) rows.push_back({"streaming", Backend::fcl, drops / 4});
 #endif
   double ref = 0;
   for (const auto& r : rows) {

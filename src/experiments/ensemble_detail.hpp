@@ -1,6 +1,8 @@
 #pragma once
 // Shared by the two explicit drivers (ensemble.cpp: raw samples; streaming.cpp: streaming
 // statistics): which queries are answered again by other backends, and the re-answering.
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -16,22 +18,28 @@ namespace asperity::detail {
 
 /// Rotations [b, e) of sphere k (m rotations per sphere): drop k m + j, one Haar rotation from
 /// its own stream, the lowest asperity by one batched query. The one definition of an explicit
-/// drop, so that both drivers see the same drops. `each(j, contact, down, nearest)` per rotation.
+/// drop, so that both drivers see the same drops. `each(j, contact, down, nearest)` per rotation,
+/// in order of j. Batches of kQueryBatch rotations: their buffers (~20 KiB) stay in L1/L2 next to
+/// the index and the histograms (answers do not depend on the batching).
+inline constexpr std::uint64_t kQueryBatch = 256;
 template <class Each>
 void query_rotations(const EnsembleConfig& c, std::uint64_t m, std::span<const Vec3> centres, const ContactQuery& index,
                      std::uint64_t k, std::uint64_t b, std::uint64_t e, Each&& each) {
-  std::vector<Rotation> q(e - b);
-  std::vector<Vec3> d(e - b);
-  std::vector<Nearest> nn(e - b);
-  for (std::uint64_t j = b; j < e; ++j) {
-    Stream st(c.seed, Purpose::orientation, k * m + j);
-    q[j - b] = random_rotation(st);
-    d[j - b] = body_down(q[j - b]);
-  }
-  index.lowest(d, nn);
-  for (std::uint64_t j = b; j < e; ++j) {
-    const Nearest& r = nn[j - b];
-    each(j, make_contact(r, centres[r.index], q[j - b], c.sphere.radius, c.sphere.asperity_radius), d[j - b], r);
+  std::array<Rotation, kQueryBatch> q;
+  std::array<Vec3, kQueryBatch> d;
+  std::array<Nearest, kQueryBatch> nn;
+  for (std::uint64_t lo = b; lo < e; lo += kQueryBatch) {
+    const std::size_t n = static_cast<std::size_t>(std::min(kQueryBatch, e - lo));
+    for (std::size_t i = 0; i < n; ++i) {
+      Stream st(c.seed, Purpose::orientation, k * m + lo + i);
+      q[i] = random_rotation(st);
+      d[i] = body_down(q[i]);
+    }
+    index.lowest(std::span<const Vec3>(d.data(), n), std::span<Nearest>(nn.data(), n));
+    for (std::size_t i = 0; i < n; ++i) {
+      const Nearest& r = nn[i];
+      each(lo + i, make_contact(r, centres[r.index], q[i], c.sphere.radius, c.sphere.asperity_radius), d[i], r);
+    }
   }
 }
 

@@ -39,6 +39,32 @@ double Reference::quantile(double u) const {
   return -sigma * std::numbers::sqrt2 * boost::math::erfc_inv(2.0 * u);
 }
 
+FineBinner::FineBinner(const Reference& ref, unsigned fine_log2) {
+  constexpr std::size_t kTable = 8192;  // interpolation error < 2 fine bins even at 2^24 bins
+  const std::size_t B = std::size_t{1} << fine_log2;
+  edge_.resize(B + 1);
+  edge_[0] = -std::numeric_limits<double>::infinity();
+  edge_[B] = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 1; j < B; ++j) {
+    edge_[j] = ref.quantile(double(j) / double(B));
+    if (!(edge_[j] >= edge_[j - 1])) throw std::logic_error("FineBinner: reference quantiles are not non-decreasing");
+  }
+  lo_ = ref.kind == Reference::Kind::rayleigh ? 0.0 : -8.0 * ref.sigma;
+  const double h = (8.0 * ref.sigma - lo_) / double(kTable);
+  inv_h_ = 1.0 / h;
+  tmax_ = std::nextafter(double(kTable), 0.0);
+  table_.resize(kTable + 1);
+  for (std::size_t i = 0; i <= kTable; ++i) table_[i] = ref.cdf(lo_ + double(i) * h) * double(B);
+  last_ = B - 1;
+  // The shortcut needs g non-decreasing: the table must be (then g is, up to an ulp of g at a node,
+  // << the 1e-6 allowance below for any B <= 2^24), and g(x_j) within slack of j at every edge.
+  for (std::size_t i = 1; i <= kTable; ++i)
+    if (!(table_[i] >= table_[i - 1])) return;  // slack_ stays 1: always the comparisons
+  double worst = 0;
+  for (std::size_t j = 1; j < B; ++j) worst = std::max(worst, std::abs(guess(edge_[j]) - double(j)));
+  slack_ = std::min(1.0, worst + 1e-6);
+}
+
 std::string Reference::name() const {
   std::ostringstream os;
   os << (kind == Kind::rayleigh ? "Rayleigh" : "normal") << "(sigma = " << sigma << ")";

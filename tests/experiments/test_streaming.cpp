@@ -60,8 +60,10 @@ TEST(Streaming, CountsTheSameDropsAsTheRawPath) {
 }
 
 TEST(Streaming, SameBitsForOneAndTwoThreads) {
-  // Small spheres (whole spheres per thread), big spheres (one sphere's units in parallel), sampled.
+  // Small spheres (whole spheres per thread), big spheres (one sphere's units in parallel), big
+  // spheres but enough of them (whole spheres per thread: 18 units each), sampled.
   for (const auto& c : {config(Mode::explicit_spheres, 64, 64 * 300), config(Mode::explicit_spheres, 2, 2 * 80000),
+                        config(Mode::explicit_spheres, 8, 8 * 70000),
                         config(Mode::sampled, 1, 50000)})
     EXPECT_TRUE(run(c, 1) == run(c, 2)) << to_string(c.mode) << " K = " << c.spheres;
 }

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "asperity/core/random.hpp"
 #include "asperity/laws/binned.hpp"
@@ -174,4 +175,39 @@ TEST(Binned, BlockBinsFeedTheSphereBootstrap) {
   // The pooled cdf at edge j is j/C up to its error band (the reference is the true law).
   for (std::size_t j = 0; j < band.x.size(); j += 97)
     EXPECT_NEAR(band.cdf[j], double(j + 1) / double(s.coarse_bins()), 5 * band.se[j] + 1e-12) << j;
+}
+
+// FineBinner (the streaming path's binning): bin j is exactly x_j <= x < x_(j+1) with the edges
+// the tests evaluate their laws at, and it agrees with fine_bin(cdf(x)) away from rounding of an
+// edge: 2e5 random x per case (the law's bulk and far tails), at 2^10, 2^16 and 2^20 bins. A
+// disagreement needs x within ~1e-16 relative of one of 2^20 edges: probability ~1e-10 per x.
+TEST(Binned, FineBinnerIsTheEdgeComparisonAndAgreesWithTheCdf) {
+  for (const Reference ref : {Reference{Reference::Kind::rayleigh, 3e-6}, Reference{Reference::Kind::normal, 3e-6}})
+    for (unsigned k : {10u, 16u, 20u}) {
+      const FineBinner bin(ref, k);
+      const BinnedStats s = make_binned(ref, 1, k, 10);
+      const std::size_t B = s.fine_bins();
+      std::size_t disagree = 0;
+      for (std::uint64_t i = 0; i < 200000; ++i) {
+        Stream st(7, Purpose::test, i, k);
+        const double u = st.uniform0(), w = st.uniform0();
+        // Half from the law itself, half uniform over +-12 sigma (tails beyond the guess table).
+        const double x = i % 2 ? ref.quantile(u) : (ref.kind == Reference::Kind::rayleigh ? 12 * w : 24 * w - 12) * ref.sigma;
+        disagree += bin(x) != s.fine_bin(ref.cdf(x));
+      }
+      EXPECT_EQ(disagree, 0u) << ref.name() << " 2^" << k;
+      // The shortcut (no edge read) applies to most samples at the default 2^16 bins.
+      if (k <= 16) {
+        EXPECT_LT(bin.slack(), 0.05) << ref.name() << " 2^" << k;
+      }
+      // At every 97th edge: x_j is in bin j, the double below it in bin j - 1 (edges are distinct here).
+      for (std::size_t j = 1; j < B; j += 97) {
+        const double e = ref.quantile(double(j) / double(B));
+        ASSERT_EQ(bin(e), j) << ref.name() << " 2^" << k;
+        ASSERT_EQ(bin(std::nextafter(e, -1.0)), j - 1) << ref.name() << " 2^" << k;
+      }
+      EXPECT_EQ(bin(std::numeric_limits<double>::infinity()), B - 1);
+      EXPECT_EQ(bin(-std::numeric_limits<double>::infinity()), 0u);
+      EXPECT_LT(bin(std::numeric_limits<double>::quiet_NaN()), B);
+    }
 }

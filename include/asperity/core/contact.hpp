@@ -6,7 +6,9 @@
 // direction d -- equivalently the centre nearest to d (smallest contact_key = |u - d|^2).
 // Every backend answers exactly this question and must agree bit-for-bit with `brute`:
 // the same lowest index (ties -> lowest index) and the same runner-up key.
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -71,13 +73,28 @@ struct Contact {
   bool core = false;        ///< the bare central sphere reaches the plate before any asperity
 };
 
-/// Turns a query answer into the world-frame contact of a body rotated by q, radius R, asperity
-/// radius a. r is the lowest asperity's contact point, even when `core` is set (then the central
-/// sphere's south pole, (0,0,-R), touches first; the caller decides what to do with that).
-Contact make_contact(const Nearest& n, const Vec3& u_lowest, const Rotation& q, double R, double a);
-
 /// True when the central sphere touches before an asperity whose centre has key k:
 /// R (1 - u.d) > a  <=>  R k / 2 > a.
 inline bool core_touches_first(double key, double R, double a) noexcept { return 0.5 * R * key > a; }
+
+/// Turns a query answer into the world-frame contact of a body rotated by q, radius R, asperity
+/// radius a. r is the lowest asperity's contact point, even when `core` is set (then the central
+/// sphere's south pole, (0,0,-R), touches first; the caller decides what to do with that).
+/// Inline: per drop of the streaming path, where the compiler shares body_down(q) with the query.
+inline Contact make_contact(const Nearest& n, const Vec3& u, const Rotation& q, double R, double a) {
+  Contact c;
+  c.index = n.index;
+  const Vec3 d = body_down(q);
+  // World position of the centre; the contact point is a further a straight down.
+  const Vec3 centre = q * (R * u);
+  // Height of the centre below the body centre: R u.d = R (1 - key/2), exact near the pole.
+  const double depth = R * (1.0 - 0.5 * n.key);
+  c.r = Vec3(centre.x(), centre.y(), -(depth + a));
+  // |u x d| is sin(theta) without the cancellation of sqrt(1 - cos^2).
+  c.r_xy = R * u.cross(d).norm();
+  c.gap = std::isfinite(n.runner_up_key) ? 0.5 * R * (n.runner_up_key - n.key) : std::numeric_limits<double>::infinity();
+  c.core = core_touches_first(n.key, R, a);
+  return c;
+}
 
 }  // namespace asperity

@@ -52,6 +52,50 @@ struct Reference {
   friend bool operator==(const Reference&, const Reference&) = default;
 };
 
+/// The fine bin of a sample x, decided by the edges the binned tests use: bin j holds
+/// x_j <= x < x_(j+1) with x_j = ref.quantile(j 2^-k) (x_0 = -inf, x_(2^k) = +inf), the same doubles
+/// as binned_ks / binned_chi2 / to_block_bins evaluate their laws at. It agrees with
+/// fine_bin(ref.cdf(x)) except for x within rounding of an edge (where the cdf's rounding decided,
+/// the edge now does). Fast, and never dependent on an approximation being good: g(x), the
+/// reference cdf (times 2^k) tabulated on a fine x grid and interpolated linearly, is a
+/// non-decreasing function of x (up to one ulp at table nodes), and the construction measures
+/// slack = max_j |g(x_j) - j| over all edges. If frac(g(x)) lies in (slack, 1 - slack), then
+/// g(x_m) < g(x) < g(x_(m+1)) for m = floor(g(x)), hence x_m <= x < x_(m+1): the bin is m without
+/// reading an edge. Otherwise (within slack of an edge: ~2 slack of the samples; slack ~ 1e-2 at
+/// 2^16 bins) exact comparisons with the edges, walking from the guess, decide. Immutable: share it.
+class FineBinner {
+ public:
+  /// Throws std::logic_error if the computed edges are not non-decreasing.
+  FineBinner(const Reference& ref, unsigned fine_log2);
+  std::size_t operator()(double x) const noexcept {
+    const double g = guess(x);
+    std::size_t k = g > 0 ? (g < double(last_) ? static_cast<std::size_t>(g) : last_) : 0;
+    const double f = g - double(k);
+    if (f > slack_ && f < 1.0 - slack_) return k;  // g in (k, k + 1), clear of both edges' g
+    const double* e = edge_.data();
+    while (k < last_ && x >= e[k + 1]) ++k;
+    while (k > 0 && x < e[k]) --k;
+    return k;
+  }
+  /// The largest |g(x_j) - j| over the edges, plus a rounding allowance (tests, reports).
+  double slack() const noexcept { return slack_; }
+  std::size_t memory_bytes() const noexcept { return (edge_.capacity() + table_.capacity()) * sizeof(double); }
+
+ private:
+  double guess(double x) const noexcept {
+    double t = (x - lo_) * inv_h_;
+    t = t > 0 ? t : 0;  // NaN too
+    t = t < tmax_ ? t : tmax_;
+    const auto i = static_cast<std::size_t>(t);
+    return table_[i] + (t - double(i)) * (table_[i + 1] - table_[i]);
+  }
+  std::vector<double> edge_;   // x_0 .. x_(2^k)
+  std::vector<double> table_;  // 2^k ref.cdf at lo + i h, i = 0 .. kTable
+  double lo_ = 0, inv_h_ = 1, tmax_ = 0;
+  double slack_ = 1;           // >= 0.5: the shortcut never applies
+  std::size_t last_ = 0;       // 2^k - 1
+};
+
 struct BinnedStats {
   Reference ref;
   unsigned fine_log2 = 16, coarse_log2 = 10;

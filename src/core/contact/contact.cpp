@@ -61,20 +61,4 @@ std::unique_ptr<ContactQuery> make_contact_query(Backend backend, std::span<cons
   throw std::invalid_argument("make_contact_query: unknown backend");
 }
 
-Contact make_contact(const Nearest& n, const Vec3& u, const Rotation& q, double R, double a) {
-  Contact c;
-  c.index = n.index;
-  const Vec3 d = body_down(q);
-  // World position of the centre; the contact point is a further a straight down.
-  const Vec3 centre = q * (R * u);
-  // Height of the centre below the body centre: R u.d = R (1 - key/2), exact near the pole.
-  const double depth = R * (1.0 - 0.5 * n.key);
-  c.r = Vec3(centre.x(), centre.y(), -(depth + a));
-  // |u x d| is sin(theta) without the cancellation of sqrt(1 - cos^2).
-  c.r_xy = R * u.cross(d).norm();
-  c.gap = std::isfinite(n.runner_up_key) ? 0.5 * R * (n.runner_up_key - n.key) : std::numeric_limits<double>::infinity();
-  c.core = core_touches_first(n.key, R, a);
-  return c;
-}
-
 }  // namespace asperity

@@ -10,13 +10,14 @@
 // cell edges E_0 = -S < E_1 < ... < E_G = S are equally spaced in ANGLE (E_k = tan(alpha_k)), so
 // cells hold about the same number of points everywhere; the cell k of a coordinate s is DEFINED by
 // the exact comparisons E_k <= s < E_(k+1) (a lookup table only guesses k). Cells are numbered
-// face-major, then t row, then s column, in one CSR array: cs_ (cell starts) and, struct-of-arrays,
-// x, y, z (bit-exact copies of the input) and the original index. Within a cell points are in
-// index order, so the structure does not depend on the thread count.
+// face-major, then t row, then s column, in one CSR array: cs_ (cell starts) and 32-byte records of
+// x, y, z (bit-exact copies of the input) and the original index (one record per point: a run of
+// points is one stretch of memory). Within a cell points are in index order, so the structure does
+// not depend on the thread count.
 //
 // Query. The 3x3 cells around d's cell are three contiguous runs of points (one per row). The fast
-// path reads a fixed kRowSlots points per run (slots past the run's end get an infinite key), so no
-// branch depends on the data, computes all keys with (target-cloned) vector arithmetic -- the same
+// path reads each run's blocks of four records (up to kRowSlots points; slots past the run's end get
+// an infinite key), computes all keys with (target-cloned) vector arithmetic -- the same
 // IEEE operations in the same order as asperity::contact_key, hence the same bits -- and reduces
 // them to the canonical top two (the two smallest (key, index) pairs, which is what TopTwo keeps
 // when, as on one face, no index repeats; an exact tie for the lowest key is left to TopTwo
@@ -136,6 +137,15 @@ inline bool is_unit(double x, double y, double z) noexcept {
 
 // ---- fast-path kernel ---------------------------------------------------------------------------
 
+/// One stored point: its coordinates (bit-exact copies of the input) and original index in one
+/// 32-byte record, so a run of points is one contiguous stretch of memory (~2-3 cache lines for
+/// the ~4 points of a 3-cell row) instead of four arrays' worth.
+struct alignas(32) Pt {
+  double x, y, z;
+  std::uint32_t id, pad;
+};
+static_assert(sizeof(Pt) == 32);
+
 struct Runs {
   std::uint32_t begin[3];
   std::uint32_t size[3];  // each <= kRowSlots, total >= 2
@@ -153,7 +163,6 @@ struct TopPair {
 #pragma GCC diagnostic ignored "-Wpsabi"
 using v4d = double __attribute__((vector_size(32)));
 using v4l = long long __attribute__((vector_size(32)));
-using v4u = std::uint32_t __attribute__((vector_size(16)));
 
 template <class V, class T>
 inline V loadu(const T* p) noexcept {
@@ -164,22 +173,37 @@ inline V loadu(const T* p) noexcept {
 
 /// The two smallest keys over the three runs and their indices, when the keys differ.
 /// Key arithmetic: ((x-dx)^2 + (y-dy)^2) + (z-dz)^2, lane by lane, exactly contact_key's.
+/// Reads blocks of four records (transposed to x, y, z, id lanes) only while the run has points
+/// in them, so no cache line beyond the run's last block is touched.
 ASPERITY_GRID_CLONES
-TopPair top_pair(const double* xs, const double* ys, const double* zs, const std::uint32_t* id, const Runs& runs,
-                 double dx, double dy, double dz) noexcept {
+TopPair top_pair(const Pt* pts, const Runs& runs, double dx, double dy, double dz) noexcept {
   constexpr int kB = kRowSlots / 4;  // blocks of four slots per run
   const v4d DX = {dx, dx, dx, dx}, DY = {dy, dy, dy, dy}, DZ = {dz, dz, dz, dz};
   const v4d INF = {kInf, kInf, kInf, kInf};
+  const long long none = kNone;
   v4d key[3 * kB];
+  v4l ids[3 * kB];
   for (int r = 0; r < 3; ++r) {
     const long long n = runs.size[r];
     const v4l size = {n, n, n, n};
     for (int q = 0; q < kB; ++q) {
-      const std::size_t o = runs.begin[r] + 4u * static_cast<unsigned>(q);
-      const v4d x = loadu<v4d>(xs + o) - DX, y = loadu<v4d>(ys + o) - DY, z = loadu<v4d>(zs + o) - DZ;
+      if (4 * q >= n) {
+        key[r * kB + q] = INF;
+        ids[r * kB + q] = v4l{none, none, none, none};
+        continue;
+      }
+      const Pt* p = pts + runs.begin[r] + 4u * static_cast<unsigned>(q);
+      const v4d p0 = loadu<v4d>(p), p1 = loadu<v4d>(p + 1), p2 = loadu<v4d>(p + 2), p3 = loadu<v4d>(p + 3);
+      const v4d t0 = __builtin_shuffle(p0, p1, v4l{0, 4, 2, 6}), t1 = __builtin_shuffle(p0, p1, v4l{1, 5, 3, 7});
+      const v4d t2 = __builtin_shuffle(p2, p3, v4l{0, 4, 2, 6}), t3 = __builtin_shuffle(p2, p3, v4l{1, 5, 3, 7});
+      const v4d x = __builtin_shuffle(t0, t2, v4l{0, 1, 4, 5}) - DX, y = __builtin_shuffle(t1, t3, v4l{0, 1, 4, 5}) - DY;
+      const v4d z = __builtin_shuffle(t0, t2, v4l{2, 3, 6, 7}) - DZ;
+      // The id word (id, pad = 0) read as one 64-bit integer is the id.
+      const v4l id = reinterpret_cast<v4l>(__builtin_shuffle(t1, t3, v4l{2, 3, 6, 7}));
       const v4d k = (x * x + y * y) + z * z;
       const v4l slot = v4l{0, 1, 2, 3} + 4 * q;
       key[r * kB + q] = slot < size ? k : INF;
+      ids[r * kB + q] = slot < size ? id : v4l{none, none, none, none};
     }
   }
   // The two smallest values with multiplicity, per lane (a1 <= a2), then across lanes.
@@ -200,15 +224,13 @@ TopPair top_pair(const double* xs, const double* ys, const double* zs, const std
   const double m1 = a1[0], m2 = a2[0];
   if (!(m1 < m2)) return {m1, m2, kNone, kNone, false};
   // m1 < m2: exactly one key equals m1; the lowest index among the keys equal to m2.
-  const long long none = kNone;
   v4l e1 = {none, none, none, none}, e2 = e1;
-  for (int r = 0; r < 3; ++r)
-    for (int q = 0; q < kB; ++q) {
-      const v4l idx = __builtin_convertvector(loadu<v4u>(id + runs.begin[r] + 4 * q), v4l);
-      const v4d v = key[r * kB + q];
-      e1 = ((v == a1) & (idx < e1)) ? idx : e1;
-      e2 = ((v == a2) & (idx < e2)) ? idx : e2;
-    }
+  for (int q = 0; q < 3 * kB; ++q) {
+    const v4l idx = ids[q];
+    const v4d v = key[q];
+    e1 = ((v == a1) & (idx < e1)) ? idx : e1;
+    e2 = ((v == a2) & (idx < e2)) ? idx : e2;
+  }
   for (const v4l swap : {v4l{2, 3, 0, 1}, v4l{1, 0, 3, 2}}) {
     const v4l f1 = __builtin_shuffle(e1, swap), f2 = __builtin_shuffle(e2, swap);
     e1 = f1 < e1 ? f1 : e1;
@@ -269,7 +291,7 @@ class Grid final : public ContactQuery {
     if (out.size() != d.size()) throw std::invalid_argument("lowest(): output size differs from input size");
     // Software pipeline: query q is located (and its cell starts prefetched) at step q, its points
     // are prefetched at step q + kLag, and it is searched at step q + 2 kLag.
-    constexpr std::size_t kLag = 8, kRing = 2 * kLag + 1;
+    constexpr std::size_t kLag = 8, kRing = 32;  // >= 2 kLag + 1; a power of two: % is a mask
     std::array<Loc, kRing> loc;
     const std::size_t n = d.size();
     for (std::size_t step = 0; step < n + 2 * kLag; ++step) {
@@ -291,8 +313,7 @@ class Grid final : public ContactQuery {
   }
 
   std::size_t memory_bytes() const override {
-    return sizeof(*this) + (cs_.capacity() + id_.capacity()) * sizeof(std::uint32_t) +
-           (xs_.capacity() + ys_.capacity() + zs_.capacity()) * sizeof(double) +
+    return sizeof(*this) + cs_.capacity() * sizeof(std::uint32_t) + pts_.capacity() * sizeof(Pt) +
            (edge_.capacity() + invn_.capacity()) * sizeof(double) + guess_.capacity() * sizeof(std::int32_t);
   }
 
@@ -345,6 +366,11 @@ class Grid final : public ContactQuery {
     const double pa = p[a];
     const double p3 = std::abs(pa);
     if (!(p3 > 0)) return kNone;
+    // Most points are far outside two of their three candidate faces: skip those without the
+    // division. Conservative: |p_b| > S (1 + 1e-9) p3 makes the computed s = p_b (1 / p3) (two
+    // roundings of 2^-53) at least S in magnitude, outside [-S, S) as the test below would find.
+    const double out = S_ * (1.0 + 1e-9) * p3;
+    if (std::abs(p[(a + 1) % 3]) > out || std::abs(p[(a + 2) % 3]) > out) return kNone;
     const double r = 1.0 / p3;
     const double s = p[(a + 1) % 3] * r, t = p[(a + 2) % 3] * r;
     const double lo = edge_.front(), hi = edge_.back();
@@ -376,10 +402,7 @@ class Grid final : public ContactQuery {
       cs_[k] = static_cast<std::uint32_t>(total);
     }
     // kPad readable slots past the end: the fast path reads whole runs of kRowSlots.
-    xs_.assign(total + kPad, 0.0);
-    ys_.assign(total + kPad, 0.0);
-    zs_.assign(total + kPad, 0.0);
-    id_.assign(total + kPad, kNone);
+    pts_.assign(total + kPad, Pt{0.0, 0.0, 0.0, kNone, 0});
     std::vector<std::uint32_t> fill(cs_.begin(), cs_.end() - 1);
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3& p = c_[i];
@@ -387,10 +410,7 @@ class Grid final : public ContactQuery {
         const std::uint32_t v = cell[3 * i + a];
         if (v == kNone) continue;
         const std::uint32_t k = fill[v]++;
-        xs_[k] = p.x();
-        ys_[k] = p.y();
-        zs_[k] = p.z();
-        id_[k] = static_cast<std::uint32_t>(i);
+        pts_[k] = Pt{p.x(), p.y(), p.z(), static_cast<std::uint32_t>(i), 0};
       }
     }
   }
@@ -425,19 +445,18 @@ class Grid final : public ContactQuery {
     }
   }
 
-  /// Prefetches the kRowSlots slots the fast path reads (all four arrays) of the three runs around
-  /// L: every cache line of [b, b + kRowSlots), i.e. b, b + 8, ... (< b + kRowSlots) and the last.
+  /// Prefetches the records the fast path reads of the three runs around L: every cache line of
+  /// its blocks of four, [b, b + 4 ceil(n / 4)) for a run of n <= kRowSlots points (longer runs
+  /// take the general path: their first kRowSlots).
   void prefetch_points(const Loc& L) const noexcept {
     const std::uint32_t* cs = cs_.data() + L.base;
-    const int i0 = std::max(L.i - 1, 0);
+    const int i0 = std::max(L.i - 1, 0), i1 = std::min(L.i + 2, G_);
     for (int r = std::max(L.j - 1, 0); r <= std::min(L.j + 1, G_ - 1); ++r) {
-      const std::uint32_t b = cs[r * G_ + i0], e = b + kRowSlots - 1;
-      for (const double* a : {xs_.data(), ys_.data(), zs_.data()}) {
-        for (std::uint32_t o = 0; o < kRowSlots; o += 8) prefetch(a + b + o);
-        prefetch(a + e);
-      }
-      prefetch(id_.data() + b);
-      prefetch(id_.data() + e);
+      const std::uint32_t b = cs[r * G_ + i0], n = std::min<std::uint32_t>(cs[r * G_ + i1] - b, kRowSlots);
+      const char* lo = reinterpret_cast<const char*>(pts_.data() + b);
+      const char* hi = reinterpret_cast<const char*>(pts_.data() + b + ((n + 3) & ~3u));
+      for (const char* a = lo; a < hi; a += 64) prefetch(a);
+      if (hi > lo) prefetch(hi - 1);
     }
   }
 
@@ -466,7 +485,7 @@ class Grid final : public ContactQuery {
       }
       if (std::max(std::max(runs.size[0], runs.size[1]), runs.size[2]) <= kRowSlots &&
           runs.size[0] + runs.size[1] + runs.size[2] >= 2) {
-        const TopPair t = top_pair(xs_.data(), ys_.data(), zs_.data(), id_.data(), runs, d.x(), d.y(), d.z());
+        const TopPair t = top_pair(pts_.data(), runs, d.x(), d.y(), d.z());
         if (t.ok) {
           const double* E = edge_.data();
           const double db = L.db, dc = L.dc, d3 = L.d3;
@@ -486,8 +505,9 @@ class Grid final : public ContactQuery {
 
   void scan(std::uint32_t b, std::uint32_t e, const Vec3& d, TopTwo& top) const noexcept {
     for (std::uint32_t k = b; k < e; ++k) {
-      const double x = xs_[k] - d.x(), y = ys_[k] - d.y(), z = zs_[k] - d.z();
-      top.offer(id_[k], x * x + y * y + z * z);  // contact_key's expression
+      const Pt& p = pts_[k];
+      const double x = p.x - d.x(), y = p.y - d.y(), z = p.z - d.z();
+      top.offer(p.id, x * x + y * y + z * z);  // contact_key's expression
     }
   }
 
@@ -554,8 +574,7 @@ class Grid final : public ContactQuery {
   std::vector<double> invn_;         // 1 / sqrt(1 + E_k^2)
   std::vector<std::int32_t> guess_;  // uniform bin -> cell guess
   Array<std::uint32_t> cs_;          // cell starts, 6 G^2 + 1
-  Array<double> xs_, ys_, zs_;       // stored points (+ kPad)
-  Array<std::uint32_t> id_;          // their original indices
+  Array<Pt> pts_;                    // stored points and their original indices (+ kPad)
 };
 
 }  // namespace
