@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <ostream>
 #include <limits>
 #include <locale>
@@ -478,20 +479,50 @@ void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t i
   }
 }
 
-template <class Member>
+// One group to analyse: a speed window [lo, hi] or an impact number (lo = hi = k).
+struct GroupSpec {
+  bool window;
+  double lo, hi;
+  std::uint64_t index;  // its bootstrap's stream index
+};
+
 BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const std::vector<BounceResidualLaw>& laws,
-                       const Restitution& en, std::string by, double lo, double hi, const Member& member,
-                       std::uint64_t seed, std::uint64_t index) {
+                       const Restitution& en, const GroupSpec& spec, std::uint64_t seed) {
   BounceGroup g;
-  const bool window = by == "speed";
-  g.by = std::move(by), g.lo = lo, g.hi = hi;
-  g.quantity = window ? "eps-eps_n(u)" : "eps";
-  GroupSums t = collect_group(s, b, en, laws.size(), window, member, g);
+  g.by = spec.window ? "speed" : "impact", g.lo = spec.lo, g.hi = spec.hi;
+  g.quantity = spec.window ? "eps-eps_n(u)" : "eps";
+  const auto k = static_cast<std::uint32_t>(spec.lo);
+  GroupSums t = spec.window ? collect_group(s, b, en, laws.size(), true,
+                                            [&](std::size_t j) { return s.speed[j] >= spec.lo && s.speed[j] <= spec.hi; }, g)
+                            : collect_group(s, b, en, laws.size(), false, [&](std::size_t j) { return s.number[j] == k; }, g);
   residual_statistics(t, laws, g);
   group_moments(t, g);
   std::sort(g.sorted.begin(), g.sorted.end());
-  laplace_test(b, seed, index, g);
+  laplace_test(b, seed, spec.index, g);
   return g;
+}
+
+// The groups side by side, one thread each (each group is a pure function of the samples and its
+// own streams, so the report is the same for any thread count). With fewer groups than twice the
+// threads they run one after the other and each bootstrap uses every thread instead.
+std::vector<BounceGroup> make_groups(const BounceSamples& s, const BounceExperiment& b,
+                                     const std::vector<BounceResidualLaw>& laws, const Restitution& en,
+                                     const std::vector<GroupSpec>& specs, std::uint64_t seed) {
+  std::vector<BounceGroup> groups(specs.size());
+  std::vector<std::exception_ptr> errors(specs.size());
+  const auto m = static_cast<std::int64_t>(specs.size());
+#pragma omp parallel for schedule(dynamic, 1) if (m >= 2 * omp_get_max_threads())
+  for (std::int64_t i = 0; i < m; ++i) {
+    const auto j = static_cast<std::size_t>(i);
+    try {
+      groups[j] = make_group(s, b, laws, en, specs[j], seed);
+    } catch (...) {
+      errors[j] = std::current_exception();  // an exception must not leave the parallel region
+    }
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  return groups;
 }
 
 }  // namespace
@@ -509,14 +540,10 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
   const auto en = viscoelastic_pade14(b.beta);
   const std::vector<BounceResidualLaw> laws = residual_laws(s, b);
   const std::uint64_t base = 1000000 + 1000 * static_cast<std::uint64_t>(s.variant);
-  std::uint64_t gi = 0;
-  for (const auto& [lo, hi] : b.windows)
-    r.groups.push_back(make_group(s, b, laws, *en, "speed", lo, hi,
-                                  [&, lo = lo, hi = hi](std::size_t j) { return s.speed[j] >= lo && s.speed[j] <= hi; },
-                                  seed, base + gi++));
-  for (unsigned k : b.impact_numbers)
-    r.groups.push_back(make_group(s, b, laws, *en, "impact", k, k, [&](std::size_t j) { return s.number[j] == k; }, seed,
-                                  base + gi++));
+  std::vector<GroupSpec> specs;
+  for (const auto& [lo, hi] : b.windows) specs.push_back({true, lo, hi, base + specs.size()});
+  for (unsigned k : b.impact_numbers) specs.push_back({false, double(k), double(k), base + specs.size()});
+  r.groups = make_groups(s, b, laws, *en, specs, seed);
   return r;
 }
 
