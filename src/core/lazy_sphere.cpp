@@ -1,7 +1,6 @@
 #include "asperity/core/lazy_sphere.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -13,24 +12,50 @@
 
 namespace asperity {
 
-std::uint64_t binomial_half(std::uint64_t n, Stream& s) {
-  if (n <= 512) {
-    std::uint64_t k = 0, left = n;
-    while (left >= 64) k += static_cast<std::uint64_t>(std::popcount(s.bits())), left -= 64;
-    if (left) k += static_cast<std::uint64_t>(std::popcount(s.bits() & ((std::uint64_t{1} << left) - 1)));
-    return k;
-  }
-  // Inversion in the order mode, mode+1, mode-1, mode+2, ... (any fixed order of the support is
-  // a valid inversion); the pmf ratios are exact rationals, the mode's pmf comes from lgamma.
-  const double dn = static_cast<double>(n);
+namespace {
+
+// Bits set in x. The baseline x86-64 target has no popcnt instruction, where std::popcount is a
+// libgcc call per word; this is inline.
+inline std::uint64_t popcount64(std::uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return (x * 0x0101010101010101ull) >> 56;
+}
+
+double mode_pmf(std::uint64_t n) {
+  const double dn = static_cast<double>(n), km = static_cast<double>(n / 2);
+  return std::exp(std::lgamma(dn + 1) - std::lgamma(km + 1) - std::lgamma(dn - km + 1) - dn * std::numbers::ln2);
+}
+
+// Inversion in the order mode, mode+1, mode-1, mode+2, ... (any fixed order of the support is a
+// valid inversion); the pmf ratios are exact rationals. u = U - pmf(mode) >= 0 on entry.
+std::uint64_t walk_from_mode(std::uint64_t n, double p_mode, double u) {
   const std::uint64_t mode = n / 2;
-  const double km = static_cast<double>(mode);
-  const double p_mode = std::exp(std::lgamma(dn + 1) - std::lgamma(km + 1) - std::lgamma(dn - km + 1) - dn * std::numbers::ln2);
-  double u = s.uniform0() - p_mode;
-  if (u < 0) return mode;
   double p_up = p_mode, p_dn = p_mode;
   std::uint64_t up = mode, dn_k = mode;
-  while (up < n || dn_k > 0) {
+  // While both sides are open, each step's two ratios (n - up)/(up + 1) and dn/(n - dn + 1) come
+  // from one two-lane division (lane-wise IEEE, the same quotients as two scalar divisions; the
+  // divisions were the walk's cost). Numerators and denominators are integers < 2^53, kept as
+  // doubles and stepped by 1 exactly. Every other operation is the scalar loop's, in its order.
+  using v2 = double __attribute__((vector_size(16)));
+  v2 num = {static_cast<double>(n - up), static_cast<double>(dn_k)};
+  v2 den = {static_cast<double>(up + 1), static_cast<double>(n - dn_k + 1)};
+  const v2 one = {1.0, 1.0};
+  while (up < n && dn_k > 0) {
+    const v2 q = num / den;
+    num -= one, den += one;
+    p_up *= q[0];
+    ++up;
+    u -= p_up;
+    if (u < 0) return up;
+    p_dn *= q[1];
+    --dn_k;
+    u -= p_dn;
+    if (u < 0) return dn_k;
+    if (p_up < 1e-300 && p_dn < 1e-300) return mode;
+  }
+  while (up < n || dn_k > 0) {  // one side closed (small n): the plain loop
     if (up < n) {
       p_up *= static_cast<double>(n - up) / static_cast<double>(up + 1);
       ++up;
@@ -48,8 +73,30 @@ std::uint64_t binomial_half(std::uint64_t n, Stream& s) {
   return mode;  // u left over by rounding (probability ~1e-16)
 }
 
-LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size)
-    : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)) {
+}  // namespace
+
+double BinomialModeCache::operator()(std::uint64_t n) {
+  if (n >= p_.size()) return mode_pmf(n);
+  double p = p_[n].load(std::memory_order_relaxed);
+  if (p == 0) p_[n].store(p = mode_pmf(n), std::memory_order_relaxed);
+  return p;
+}
+
+std::uint64_t binomial_half(std::uint64_t n, Stream& s, BinomialModeCache* cache) {
+  if (n <= 512) {
+    std::uint64_t k = 0, left = n;
+    while (left >= 64) k += popcount64(s.bits()), left -= 64;
+    if (left) k += popcount64(s.bits() & ((std::uint64_t{1} << left) - 1));
+    return k;
+  }
+  const double p_mode = cache ? (*cache)(n) : mode_pmf(n);
+  const double u = s.uniform0() - p_mode;
+  return u < 0 ? n / 2 : walk_from_mode(n, p_mode, u);
+}
+
+LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size,
+                       BinomialModeCache* modes)
+    : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)), modes_(modes) {
   check_asperity_count(n, "lazy sphere: asperities");
   reset(seed, sphere_id);
 }
@@ -66,7 +113,7 @@ void LazySphere::reset(std::uint64_t seed, std::uint64_t sphere_id) {
 void LazySphere::expand(std::size_t i) {
   Node c = nodes_[i];
   Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id);
-  const std::uint64_t left = binomial_half(c.count, s);
+  const std::uint64_t left = binomial_half(c.count, s, modes_);
   // Split the longer side (arc lengths) at its equal-area midpoint.
   const double dtheta = c.t0 - c.t1;  // acos(z0) - acos(z1)
   const double smax = std::max(std::sqrt((1 - c.z0) * (1 + c.z0)), std::sqrt((1 - c.z1) * (1 + c.z1)));

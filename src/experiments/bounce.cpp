@@ -270,12 +270,16 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   const std::uint64_t chunk = kBounceBlock;
   std::vector<SequenceOut> outs(static_cast<std::size_t>(std::min(chunk, b.sequences)));
   const int nt = threads > 0 ? threads : omp_get_max_threads();
+  // The mode pmf of every cell count the spheres split, computed once for all sequences (8 bytes
+  // per possible count; above 2^24 centres the counts near the root are computed each time).
+  std::unique_ptr<BinomialModeCache> modes;
+  if (explicit_geometry) modes = std::make_unique<BinomialModeCache>(std::min<std::uint64_t>(sphere.asperities, 1u << 24));
   for (std::uint64_t start = 0; start < b.sequences; start += chunk) {
     const std::int64_t m = static_cast<std::int64_t>(std::min(chunk, b.sequences - start));
 #pragma omp parallel num_threads(nt)
     {
       std::unique_ptr<LazySphere> S;
-      if (explicit_geometry) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0);
+      if (explicit_geometry) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0, 8, modes.get());
 #pragma omp for schedule(dynamic, 8)
       for (std::int64_t j = 0; j < m; ++j) {
         auto& o = outs[static_cast<std::size_t>(j)];
