@@ -84,6 +84,7 @@ class LazySphere {
     // rule's polar extent, computed exactly as before so the sphere is the same sample) and
     // cos, sin of p0, p1 (the bound's phi part without a cos per call).
     double t0, t1, c0, s0, c1, s1;
+    double r0, r1;  // sqrt(1 - z^2) at z0, z1 (the bound's and the split rule's, without a sqrt per call)
     std::uint64_t id;      // heap numbering: root 1, children 2 id and 2 id + 1
     std::uint64_t count;   // centres in the cell
     std::uint64_t offset;  // global index of its first centre
