@@ -468,7 +468,7 @@ void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t i
                                            : std::min<std::size_t>(std::max(b.bootstrap, B_floor),
                                                                    std::max<std::size_t>(19, 20000000 / g.n));
     if (b.bootstrap > 0) {
-      g.gof = laplace_gof(g.sorted, g.fit, B, seed, index);
+      g.gof = laplace_gof(g.sorted, g.fit, B, seed, index, SequentialStop{b.bootstrap_stop, b.alpha});
       // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
       // when floor > alpha that is no verdict (the group can never reject at this B).
       const double floor = 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap));

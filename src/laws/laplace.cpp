@@ -1,5 +1,7 @@
 #include "asperity/laws/laplace.hpp"
 
+#include <omp.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -200,29 +202,56 @@ bool replicate_law(std::span<const double> t, double pl, std::vector<double>& R,
 }
 }  // namespace
 
+namespace {
+struct ReplicateScratch {
+  std::vector<double> y, tail, R, L;
+};
+
+// Whether replicate b of the bootstrap reaches the data's distance D.
+bool replicate_exceeds(const LaplaceFit& fit, double pl, double D, std::size_t n, std::uint64_t seed,
+                       std::uint64_t stream_index, std::size_t b, ReplicateScratch& w) {
+  w.y.resize(n), w.tail.resize(n + 1);
+  Stream s(seed, Purpose::analysis, stream_index, static_cast<std::uint64_t>(b) + 1);
+  sorted_sample(fit.law, s, w.y, w.tail);
+  AsymmetricLaplace law;
+  return replicate_law(w.y, pl, w.R, w.L, law) && ks_distance_reaches(w.y, law, D);
+}
+}  // namespace
+
 LaplaceGof laplace_gof(std::span<const double> sorted, const LaplaceFit& fit, std::size_t bootstrap, std::uint64_t seed,
-                       std::uint64_t stream_index) {
+                       std::uint64_t stream_index, SequentialStop stop) {
   LaplaceGof g;
   g.D = ks_distance(sorted, fit.law);
   g.bootstrap = bootstrap;
-  const std::size_t n = sorted.size();
-  const std::int64_t B = static_cast<std::int64_t>(bootstrap);
-  std::vector<std::uint8_t> exceed(bootstrap, 0);
-#pragma omp parallel
-  {
-    std::vector<double> y(n), tail(n + 1), R, L;
-    const double pl = fit.law.c() / (fit.law.a() + fit.law.c());  // P(t < m) of the generating law
-#pragma omp for schedule(dynamic, 1)
-    for (std::int64_t b = 0; b < B; ++b) {
-      Stream s(seed, Purpose::analysis, stream_index, static_cast<std::uint64_t>(b) + 1);
-      sorted_sample(fit.law, s, y, tail);
-      AsymmetricLaplace law;
-      exceed[static_cast<std::size_t>(b)] = replicate_law(y, pl, R, L, law) && ks_distance_reaches(y, law, g.D) ? 1 : 0;
+  const std::size_t n = sorted.size(), B = bootstrap;
+  const double pl = fit.law.c() / (fit.law.a() + fit.law.c());  // P(t < m) of the generating law
+  // Without a stop all B replicates form one parallel batch; with one, batches of one replicate
+  // per thread are decided in replicate order (the replicates past the stop are discarded).
+  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
+  const std::size_t batch = stop.exceedances == 0 ? std::max<std::size_t>(B, 1) : static_cast<std::size_t>(threads);
+  std::vector<ReplicateScratch> scratch(static_cast<std::size_t>(threads));
+  std::vector<std::uint8_t> exceed(B, 0);
+  std::size_t k = 0, done = 0;
+  for (std::size_t b0 = 0; b0 < B && !g.stopped_early; b0 += batch) {
+    const auto b1 = static_cast<std::int64_t>(std::min(B, b0 + batch));
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (b1 - static_cast<std::int64_t>(b0) > 1)
+    for (std::int64_t b = static_cast<std::int64_t>(b0); b < b1; ++b)
+      exceed[static_cast<std::size_t>(b)] =
+          replicate_exceeds(fit, pl, g.D, n, seed, stream_index, static_cast<std::size_t>(b),
+                            scratch[static_cast<std::size_t>(omp_get_thread_num())]) ? 1 : 0;
+    for (std::size_t b = b0; b < static_cast<std::size_t>(b1); ++b) {
+      k += exceed[b], done = b + 1;
+      const double kd = static_cast<double>(k);
+      if (stop.exceedances > 0 && k >= stop.exceedances && kd / static_cast<double>(done) >= stop.alpha &&
+          (kd + 1.0) / (static_cast<double>(B) + 1.0) >= stop.alpha) {
+        g.stopped_early = done < B;
+        break;
+      }
     }
   }
-  std::size_t k = 0;
-  for (auto e : exceed) k += e;
-  g.p = (1.0 + static_cast<double>(k)) / (1.0 + static_cast<double>(bootstrap));
+  g.replicates = done, g.exceedances = k;
+  g.p = g.stopped_early ? static_cast<double>(k) / static_cast<double>(done)
+                        : (1.0 + static_cast<double>(k)) / (1.0 + static_cast<double>(bootstrap));
   return g;
 }
 
