@@ -204,6 +204,7 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
                     return law.describe();
                   }()},
                  {"bootstrap", b.bootstrap},
+                 {"bootstrap_stop", b.bootstrap_stop},
                  {"alpha", b.alpha},
                  {"eps_time_note", "eps(times) = T_k / T_(k-1) from the flight times before and after impact k; it differs "
                                    "from eps = V'_z/V_z by the height differences of successive lowest points"}};
