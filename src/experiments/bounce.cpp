@@ -453,6 +453,12 @@ void group_moments(const GroupSums& t, BounceGroup& g) {
   }
 }
 
+std::size_t bootstrap_count(const BounceExperiment& b, std::size_t n) {
+  const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
+  return b.bootstrap == 0 ? 0
+                          : std::min<std::size_t>(std::max(b.bootstrap, B_floor), std::max<std::size_t>(19, 20000000 / n));
+}
+
 // Eq. 2 fitted to the (sorted) group and its parametric-bootstrap KS test.
 void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t index, BounceGroup& g) {
   if (g.n < 20) return;
@@ -463,10 +469,7 @@ void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t i
     // alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
     // for the big low-speed windows; a group left with floor >= alpha is undecided when no
     // replicate reaches D (below), never accepted.
-    const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
-    const std::size_t B = b.bootstrap == 0 ? 0
-                                           : std::min<std::size_t>(std::max(b.bootstrap, B_floor),
-                                                                   std::max<std::size_t>(19, 20000000 / g.n));
+    const std::size_t B = bootstrap_count(b, g.n);
     if (b.bootstrap > 0) {
       g.gof = laplace_gof(g.sorted, g.fit, B, seed, index, SequentialStop{b.bootstrap_stop, b.alpha});
       // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
@@ -517,9 +520,20 @@ std::vector<BounceGroup> make_groups(const BounceSamples& s, const BounceExperim
   std::vector<BounceGroup> groups(specs.size());
   std::vector<std::exception_ptr> errors(specs.size());
   const auto m = static_cast<std::int64_t>(specs.size());
+  // Largest bootstrap work (n B) first, so that no big group starts last and runs alone.
+  std::vector<std::size_t> n(specs.size(), 0), order(specs.size());
+  for (std::size_t j = 0; j < s.eps.size(); ++j)
+    for (std::size_t g = 0; g < specs.size(); ++g)
+      n[g] += specs[g].window ? (s.speed[j] >= specs[g].lo && s.speed[j] <= specs[g].hi) : s.number[j] == specs[g].lo;
+  for (std::size_t g = 0; g < order.size(); ++g) order[g] = g;
+  auto work = [&](std::size_t g) {
+    const std::size_t B = n[g] ? bootstrap_count(b, n[g]) : 0;
+    return static_cast<double>(n[g]) * static_cast<double>(std::max<std::size_t>(1, B));
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return work(x) > work(y); });
 #pragma omp parallel for schedule(dynamic, 1) if (m >= 2 * omp_get_max_threads())
   for (std::int64_t i = 0; i < m; ++i) {
-    const auto j = static_cast<std::size_t>(i);
+    const auto j = order[static_cast<std::size_t>(i)];
     try {
       groups[j] = make_group(s, b, laws, en, specs[j], seed);
     } catch (...) {
