@@ -54,7 +54,8 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
         m = fmt(g.by == "speed" ? "%.3e" : "%.8f", g.fit.m.value) + " +- " + fmt("%.1e", g.fit.m.se);
         a = fmt("%.3f", g.fit.a.value / unit) + " +- " + fmt("%.3f", g.fit.a.se / unit);
         c = fmt("%.3f", g.fit.c.value / unit) + " +- " + fmt("%.3f", g.fit.c.se / unit);
-        D = fmt("%.4f", g.gof.D), p = fmt("%.2f", g.gof.p) + (g.gof_verdict == Verdict::undecided ? "?" : "");
+        D = fmt("%.4f", g.gof.D),
+        p = fmt("%.2f", g.gof.p) + (g.gof_verdict == Verdict::undecided ? "?" : g.gof.stopped_early ? "~" : "");
       }
       std::snprintf(line, sizeof line, "%-18s %-13s %8zu %6.3f %-22s %-24s %-18s %-18s %8s %6s\n",
                     std::string(to_string(r.variant)).c_str(), grp.c_str(), g.n, g.mean_speed, mean.c_str(), m.c_str(),
@@ -73,7 +74,9 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
     o << line;
   }
   o << "a, c: rates of the asymmetric Laplace law (Eq. 2) left/right of the mode [1]; KS p from a parametric bootstrap\n"
-       "(p? = undecided: no replicate reached D and 1/(1+B) >= alpha, cannot decide at this B, not an acceptance).\n"
+       "(p? = undecided: no replicate reached D and 1/(1+B) >= alpha, cannot decide at this B, not an acceptance;\n"
+       "p~ = estimated as K/L after a sequential stop once K replicates reached D and only 'accept' was left: the verdict is\n"
+       "that of all B replicates, the value has a relative se of ~1/sqrt(K); report.json ks.replicates, ks.exceedances).\n"
        "Speed windows fit eps - eps_n(u) (eps_n of Eq. 9 at the impact speed), impact numbers k fit eps itself.\n";
   // The residual eps - eps_n(u) in every group against the semi-analytic law (theory_impact.hpp).
   bool any_theory = false;
@@ -155,7 +158,11 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
                     {"a", f.a.value}, {"a_se", jnum(f.a.se)}, {"c", f.c.value}, {"c_se", jnum(f.c.se)},
                     {"log_likelihood", f.log_likelihood}, {"se_method", "Fisher information"}};
         x["ks"] = {{"statistic", "KS"}, {"D", g.gof.D}, {"p", jnum(g.gof.p)}, {"bootstrap", g.gof.bootstrap},
-                   {"p_method", "parametric bootstrap (parameters refitted)"}, {"decisive", false},
+                   {"replicates", g.gof.replicates}, {"exceedances", g.gof.exceedances},
+                   {"p_method", g.gof.stopped_early ? "parametric bootstrap (parameters refitted), sequential: stopped after "
+                                                      "the replicates shown, p = exceedances/replicates (verdict as with all)"
+                                                    : "parametric bootstrap (parameters refitted)"},
+                   {"decisive", false},
                    {"p_floor", g.gof.bootstrap ? 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap)) : 1.0},
                    {"verdict", std::string(to_string(g.gof_verdict))}};
       } else {
@@ -197,6 +204,7 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
                     return law.describe();
                   }()},
                  {"bootstrap", b.bootstrap},
+                 {"bootstrap_stop", b.bootstrap_stop},
                  {"alpha", b.alpha},
                  {"eps_time_note", "eps(times) = T_k / T_(k-1) from the flight times before and after impact k; it differs "
                                    "from eps = V'_z/V_z by the height differences of successive lowest points"}};

@@ -1,7 +1,6 @@
 #include "asperity/core/lazy_sphere.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <functional>
 #include <numbers>
@@ -13,24 +12,53 @@
 
 namespace asperity {
 
-std::uint64_t binomial_half(std::uint64_t n, Stream& s) {
-  if (n <= 512) {
-    std::uint64_t k = 0, left = n;
-    while (left >= 64) k += static_cast<std::uint64_t>(std::popcount(s.bits())), left -= 64;
-    if (left) k += static_cast<std::uint64_t>(std::popcount(s.bits() & ((std::uint64_t{1} << left) - 1)));
-    return k;
-  }
-  // Inversion in the order mode, mode+1, mode-1, mode+2, ... (any fixed order of the support is
-  // a valid inversion); the pmf ratios are exact rationals, the mode's pmf comes from lgamma.
-  const double dn = static_cast<double>(n);
+namespace {
+
+// sqrt(1 - z^2) for z in [-1, 1], as the bound always computed it.
+inline double rim(double z) { return std::sqrt(std::max(0.0, (1 - z) * (1 + z))); }
+
+// Bits set in x. The baseline x86-64 target has no popcnt instruction, where std::popcount is a
+// libgcc call per word; this is inline.
+inline std::uint64_t popcount64(std::uint64_t x) {
+  x = x - ((x >> 1) & 0x5555555555555555ull);
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0f0f0f0f0f0f0f0full;
+  return (x * 0x0101010101010101ull) >> 56;
+}
+
+double mode_pmf(std::uint64_t n) {
+  const double dn = static_cast<double>(n), km = static_cast<double>(n / 2);
+  return std::exp(std::lgamma(dn + 1) - std::lgamma(km + 1) - std::lgamma(dn - km + 1) - dn * std::numbers::ln2);
+}
+
+// Inversion in the order mode, mode+1, mode-1, mode+2, ... (any fixed order of the support is a
+// valid inversion); the pmf ratios are exact rationals. u = U - pmf(mode) >= 0 on entry.
+std::uint64_t walk_from_mode(std::uint64_t n, double p_mode, double u) {
   const std::uint64_t mode = n / 2;
-  const double km = static_cast<double>(mode);
-  const double p_mode = std::exp(std::lgamma(dn + 1) - std::lgamma(km + 1) - std::lgamma(dn - km + 1) - dn * std::numbers::ln2);
-  double u = s.uniform0() - p_mode;
-  if (u < 0) return mode;
   double p_up = p_mode, p_dn = p_mode;
   std::uint64_t up = mode, dn_k = mode;
-  while (up < n || dn_k > 0) {
+  // While both sides are open, each step's two ratios (n - up)/(up + 1) and dn/(n - dn + 1) come
+  // from one two-lane division (lane-wise IEEE, the same quotients as two scalar divisions; the
+  // divisions were the walk's cost). Numerators and denominators are integers < 2^53, kept as
+  // doubles and stepped by 1 exactly. Every other operation is the scalar loop's, in its order.
+  using v2 = double __attribute__((vector_size(16)));
+  v2 num = {static_cast<double>(n - up), static_cast<double>(dn_k)};
+  v2 den = {static_cast<double>(up + 1), static_cast<double>(n - dn_k + 1)};
+  const v2 one = {1.0, 1.0};
+  while (up < n && dn_k > 0) {
+    const v2 q = num / den;
+    num -= one, den += one;
+    p_up *= q[0];
+    ++up;
+    u -= p_up;
+    if (u < 0) return up;
+    p_dn *= q[1];
+    --dn_k;
+    u -= p_dn;
+    if (u < 0) return dn_k;
+    if (p_up < 1e-300 && p_dn < 1e-300) return mode;
+  }
+  while (up < n || dn_k > 0) {  // one side closed (small n): the plain loop
     if (up < n) {
       p_up *= static_cast<double>(n - up) / static_cast<double>(up + 1);
       ++up;
@@ -48,8 +76,30 @@ std::uint64_t binomial_half(std::uint64_t n, Stream& s) {
   return mode;  // u left over by rounding (probability ~1e-16)
 }
 
-LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size)
-    : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)) {
+}  // namespace
+
+double BinomialModeCache::operator()(std::uint64_t n) {
+  if (n >= p_.size()) return mode_pmf(n);
+  double p = p_[n].load(std::memory_order_relaxed);
+  if (p == 0) p_[n].store(p = mode_pmf(n), std::memory_order_relaxed);
+  return p;
+}
+
+std::uint64_t binomial_half(std::uint64_t n, Stream& s, BinomialModeCache* cache) {
+  if (n <= 512) {
+    std::uint64_t k = 0, left = n;
+    while (left >= 64) k += popcount64(s.bits()), left -= 64;
+    if (left) k += popcount64(s.bits() & ((std::uint64_t{1} << left) - 1));
+    return k;
+  }
+  const double p_mode = cache ? (*cache)(n) : mode_pmf(n);
+  const double u = s.uniform0() - p_mode;
+  return u < 0 ? n / 2 : walk_from_mode(n, p_mode, u);
+}
+
+LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size,
+                       BinomialModeCache* modes)
+    : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)), modes_(modes) {
   check_asperity_count(n, "lazy sphere: asperities");
   reset(seed, sphere_id);
 }
@@ -60,16 +110,16 @@ void LazySphere::reset(std::uint64_t seed, std::uint64_t sphere_id) {
   points_.clear();
   const double two_pi = 2.0 * std::numbers::pi;
   nodes_.push_back(Node{-1.0, 1.0, 0.0, two_pi, std::acos(-1.0), std::acos(1.0), 1.0, 0.0, std::cos(two_pi), std::sin(two_pi),
-                        1, n_, 0});
+                        0.0, 0.0, 1, n_, 0});
 }
 
 void LazySphere::expand(std::size_t i) {
   Node c = nodes_[i];
   Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id);
-  const std::uint64_t left = binomial_half(c.count, s);
+  const std::uint64_t left = binomial_half(c.count, s, modes_);
   // Split the longer side (arc lengths) at its equal-area midpoint.
   const double dtheta = c.t0 - c.t1;  // acos(z0) - acos(z1)
-  const double smax = std::max(std::sqrt((1 - c.z0) * (1 + c.z0)), std::sqrt((1 - c.z1) * (1 + c.z1)));
+  const double smax = std::max(c.r0, c.r1);
   const double width = (c.p1 - c.p0) * ((c.z0 <= 0 && c.z1 >= 0) ? 1.0 : smax);  // along the widest circle
   Node a = c, b = c;
   if (width > dtheta) {
@@ -80,6 +130,7 @@ void LazySphere::expand(std::size_t i) {
     const double zm = 0.5 * (c.z0 + c.z1);
     a.z1 = zm, b.z0 = zm;
     a.t1 = b.t0 = std::acos(std::clamp(zm, -1.0, 1.0));
+    a.r1 = b.r0 = rim(zm);
   }
   a.id = 2 * c.id, b.id = 2 * c.id + 1;
   a.count = left, b.count = c.count - left;
@@ -97,7 +148,7 @@ void LazySphere::fill(std::size_t i) {
   for (std::uint64_t j = 0; j < c.count; ++j) {
     const double z = c.z0 + (c.z1 - c.z0) * s.uniform0();
     const double phi = c.p0 + (c.p1 - c.p0) * s.uniform0();
-    const double r = std::sqrt(std::max(0.0, (1 - z) * (1 + z)));
+    const double r = rim(z);
     points_.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
   }
 }
@@ -116,7 +167,7 @@ double LazySphere::lower_key(const Node& c, const Direction& q) {
   if (delta <= span) cmax = 1.0;
   else cmax = std::max(c.c0 * q.cpsi + c.s0 * q.spsi, c.c1 * q.cpsi + c.s1 * q.spsi);  // cos(p - psi)
   const double A = q.dxy * cmax, dz = q.d.z();
-  auto f = [&](double z) { return A * std::sqrt(std::max(0.0, (1 - z) * (1 + z))) + dz * z; };
+  const double f0 = A * c.r0 + dz * c.z0, f1 = A * c.r1 + dz * c.z1;  // f(z) = A sqrt(1 - z^2) + dz z
   double ub;
   if (A > 0) {
     // |(A, dz)| <= 1: no overflow, so sqrt instead of the much slower std::hypot (its last-ulp
@@ -124,9 +175,9 @@ double LazySphere::lower_key(const Node& c, const Direction& q) {
     // The concave f peaks at zs = dz / norm with f(zs) = norm; compared as dz against z norm (no
     // division), the peak inside the cell bounds it by norm itself, else the nearer end does.
     const double norm = std::sqrt(A * A + dz * dz);
-    ub = dz < c.z0 * norm ? f(c.z0) : dz > c.z1 * norm ? f(c.z1) : norm;
+    ub = dz < c.z0 * norm ? f0 : dz > c.z1 * norm ? f1 : norm;
   } else {
-    ub = std::max(f(c.z0), f(c.z1));  // convex: maximum at an end
+    ub = std::max(f0, f1);  // convex: maximum at an end
   }
   return 2.0 - 2.0 * ub - 1e-13;
 }
@@ -140,12 +191,21 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
   detail::TopTwo top;
   auto& h = heap_;
   h.clear();
-  auto cmp = std::greater<std::pair<double, std::size_t>>();
-  h.emplace_back(lower_key(nodes_[0], q), 0);
-  while (!h.empty()) {
-    std::pop_heap(h.begin(), h.end(), cmp);
-    const auto [lb, i] = h.back();
-    h.pop_back();
+  // Cells are visited in increasing (bound, cell index), as a heap of every open cell pops them;
+  // the better child of an expanded cell is kept in hand instead of pushed and popped again when
+  // it comes before the heap's top (the same order, half the heap operations).
+  using Open = std::pair<double, std::size_t>;
+  auto cmp = std::greater<Open>();
+  Open cur{lower_key(nodes_[0], q), 0};
+  for (bool in_hand = true;;) {
+    if (!in_hand) {
+      if (h.empty()) break;
+      std::pop_heap(h.begin(), h.end(), cmp);
+      cur = h.back();
+      h.pop_back();
+    }
+    in_hand = false;
+    const auto [lb, i] = cur;
     if (lb > top.second_key()) break;  // no open cell can hold a better candidate
     if (is_leaf(nodes_[i])) {
       if (nodes_[i].points < 0) fill(i);
@@ -156,12 +216,19 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
     }
     if (nodes_[i].child < 0) expand(i);
     const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
+    Open kids[2];
+    int m = 0;
     for (std::size_t k = ch; k < ch + 2; ++k) {
       if (nodes_[k].count == 0) continue;
       const double lk = lower_key(nodes_[k], q);
       if (lk > top.second_key()) continue;
-      h.emplace_back(lk, k);
-      std::push_heap(h.begin(), h.end(), cmp);
+      kids[m++] = {lk, k};
+    }
+    if (m == 2 && kids[1] < kids[0]) std::swap(kids[0], kids[1]);
+    if (m == 2) h.push_back(kids[1]), std::push_heap(h.begin(), h.end(), cmp);
+    if (m >= 1) {
+      if (h.empty() || kids[0] < h.front()) cur = kids[0], in_hand = true;
+      else h.push_back(kids[0]), std::push_heap(h.begin(), h.end(), cmp);
     }
   }
   LazyNearest r;

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <ostream>
 #include <limits>
 #include <locale>
@@ -269,12 +270,16 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   const std::uint64_t chunk = kBounceBlock;
   std::vector<SequenceOut> outs(static_cast<std::size_t>(std::min(chunk, b.sequences)));
   const int nt = threads > 0 ? threads : omp_get_max_threads();
+  // The mode pmf of every cell count the spheres split, computed once for all sequences (8 bytes
+  // per possible count; above 2^24 centres the counts near the root are computed each time).
+  std::unique_ptr<BinomialModeCache> modes;
+  if (explicit_geometry) modes = std::make_unique<BinomialModeCache>(std::min<std::uint64_t>(sphere.asperities, 1u << 24));
   for (std::uint64_t start = 0; start < b.sequences; start += chunk) {
     const std::int64_t m = static_cast<std::int64_t>(std::min(chunk, b.sequences - start));
 #pragma omp parallel num_threads(nt)
     {
       std::unique_ptr<LazySphere> S;
-      if (explicit_geometry) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0);
+      if (explicit_geometry) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0, 8, modes.get());
 #pragma omp for schedule(dynamic, 8)
       for (std::int64_t j = 0; j < m; ++j) {
         auto& o = outs[static_cast<std::size_t>(j)];
@@ -448,6 +453,12 @@ void group_moments(const GroupSums& t, BounceGroup& g) {
   }
 }
 
+std::size_t bootstrap_count(const BounceExperiment& b, std::size_t n) {
+  const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
+  return b.bootstrap == 0 ? 0
+                          : std::min<std::size_t>(std::max(b.bootstrap, B_floor), std::max<std::size_t>(19, 20000000 / n));
+}
+
 // Eq. 2 fitted to the (sorted) group and its parametric-bootstrap KS test.
 void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t index, BounceGroup& g) {
   if (g.n < 20) return;
@@ -458,12 +469,9 @@ void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t i
     // alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
     // for the big low-speed windows; a group left with floor >= alpha is undecided when no
     // replicate reaches D (below), never accepted.
-    const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
-    const std::size_t B = b.bootstrap == 0 ? 0
-                                           : std::min<std::size_t>(std::max(b.bootstrap, B_floor),
-                                                                   std::max<std::size_t>(19, 20000000 / g.n));
+    const std::size_t B = bootstrap_count(b, g.n);
     if (b.bootstrap > 0) {
-      g.gof = laplace_gof(g.sorted, g.fit, B, seed, index);
+      g.gof = laplace_gof(g.sorted, g.fit, B, seed, index, SequentialStop{b.bootstrap_stop, b.alpha});
       // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
       // when floor > alpha that is no verdict (the group can never reject at this B).
       const double floor = 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap));
@@ -478,20 +486,63 @@ void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t i
   }
 }
 
-template <class Member>
+// One group to analyse: a speed window [lo, hi] or an impact number (lo = hi = k).
+struct GroupSpec {
+  bool window;
+  double lo, hi;
+  std::uint64_t index;  // its bootstrap's stream index
+};
+
 BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const std::vector<BounceResidualLaw>& laws,
-                       const Restitution& en, std::string by, double lo, double hi, const Member& member,
-                       std::uint64_t seed, std::uint64_t index) {
+                       const Restitution& en, const GroupSpec& spec, std::uint64_t seed) {
   BounceGroup g;
-  const bool window = by == "speed";
-  g.by = std::move(by), g.lo = lo, g.hi = hi;
-  g.quantity = window ? "eps-eps_n(u)" : "eps";
-  GroupSums t = collect_group(s, b, en, laws.size(), window, member, g);
-  residual_statistics(t, laws, g);
+  g.by = spec.window ? "speed" : "impact", g.lo = spec.lo, g.hi = spec.hi;
+  g.quantity = spec.window ? "eps-eps_n(u)" : "eps";
+  const auto k = static_cast<std::uint32_t>(spec.lo);
+  GroupSums t = spec.window ? collect_group(s, b, en, laws.size(), true,
+                                            [&](std::size_t j) { return s.speed[j] >= spec.lo && s.speed[j] <= spec.hi; }, g)
+                            : collect_group(s, b, en, laws.size(), false, [&](std::size_t j) { return s.number[j] == k; }, g);
+  residual_statistics(t, laws, g);  // sorts t.res (n > 2)
   group_moments(t, g);
-  std::sort(g.sorted.begin(), g.sorted.end());
-  laplace_test(b, seed, index, g);
+  // A window's quantity is its residual, already sorted above: the same values, one sort fewer.
+  if (spec.window && std::is_sorted(t.res.begin(), t.res.end())) g.sorted = std::move(t.res);
+  else std::sort(g.sorted.begin(), g.sorted.end());
+  laplace_test(b, seed, spec.index, g);
   return g;
+}
+
+// The groups side by side, one thread each (each group is a pure function of the samples and its
+// own streams, so the report is the same for any thread count). With fewer groups than twice the
+// threads they run one after the other and each bootstrap uses every thread instead.
+std::vector<BounceGroup> make_groups(const BounceSamples& s, const BounceExperiment& b,
+                                     const std::vector<BounceResidualLaw>& laws, const Restitution& en,
+                                     const std::vector<GroupSpec>& specs, std::uint64_t seed) {
+  std::vector<BounceGroup> groups(specs.size());
+  std::vector<std::exception_ptr> errors(specs.size());
+  const auto m = static_cast<std::int64_t>(specs.size());
+  // Largest bootstrap work (n B) first, so that no big group starts last and runs alone.
+  std::vector<std::size_t> n(specs.size(), 0), order(specs.size());
+  for (std::size_t j = 0; j < s.eps.size(); ++j)
+    for (std::size_t g = 0; g < specs.size(); ++g)
+      n[g] += specs[g].window ? (s.speed[j] >= specs[g].lo && s.speed[j] <= specs[g].hi) : s.number[j] == specs[g].lo;
+  for (std::size_t g = 0; g < order.size(); ++g) order[g] = g;
+  auto work = [&](std::size_t g) {
+    const std::size_t B = n[g] ? bootstrap_count(b, n[g]) : 0;
+    return static_cast<double>(n[g]) * static_cast<double>(std::max<std::size_t>(1, B));
+  };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return work(x) > work(y); });
+#pragma omp parallel for schedule(dynamic, 1) if (m >= 2 * omp_get_max_threads())
+  for (std::int64_t i = 0; i < m; ++i) {
+    const auto j = order[static_cast<std::size_t>(i)];
+    try {
+      groups[j] = make_group(s, b, laws, en, specs[j], seed);
+    } catch (...) {
+      errors[j] = std::current_exception();  // an exception must not leave the parallel region
+    }
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  return groups;
 }
 
 }  // namespace
@@ -509,14 +560,10 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
   const auto en = viscoelastic_pade14(b.beta);
   const std::vector<BounceResidualLaw> laws = residual_laws(s, b);
   const std::uint64_t base = 1000000 + 1000 * static_cast<std::uint64_t>(s.variant);
-  std::uint64_t gi = 0;
-  for (const auto& [lo, hi] : b.windows)
-    r.groups.push_back(make_group(s, b, laws, *en, "speed", lo, hi,
-                                  [&, lo = lo, hi = hi](std::size_t j) { return s.speed[j] >= lo && s.speed[j] <= hi; },
-                                  seed, base + gi++));
-  for (unsigned k : b.impact_numbers)
-    r.groups.push_back(make_group(s, b, laws, *en, "impact", k, k, [&](std::size_t j) { return s.number[j] == k; }, seed,
-                                  base + gi++));
+  std::vector<GroupSpec> specs;
+  for (const auto& [lo, hi] : b.windows) specs.push_back({true, lo, hi, base + specs.size()});
+  for (unsigned k : b.impact_numbers) specs.push_back({false, double(k), double(k), base + specs.size()});
+  r.groups = make_groups(s, b, laws, *en, specs, seed);
   return r;
 }
 

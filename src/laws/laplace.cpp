@@ -1,5 +1,7 @@
 #include "asperity/laws/laplace.hpp"
 
+#include <omp.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -161,28 +163,95 @@ void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::vector<double>& y
 }
 }  // namespace
 
+namespace {
+// The law fit_asymmetric_laplace_sorted finds for a bootstrap replicate (drawn sorted and finite,
+// so unchecked), the same values from the same sums, with `R`, `L` reused as scratch. The scan
+// for the first minimum of g_j = sqrt(L_j) + sqrt(R_j) skips blocks that cannot hold it: L rises
+// and R falls with j (as computed: sums of non-negative terms), and sqrt and + round monotonically,
+// so on [j0, j1] every g_j >= sqrt(L_j0) + sqrt(R_j1); a block whose bound exceeds the best g so
+// far (started at the generating law's mode, where the minimum lies) is skipped. False when all
+// values are equal (no minimum).
+bool replicate_law(std::span<const double> t, double pl, std::vector<double>& R, std::vector<double>& L,
+                   AsymmetricLaplace& law) {
+  const std::size_t n = t.size();
+  R.assign(n, 0.0), L.assign(n, 0.0);
+  for (std::size_t j = n - 1; j > 0; --j) R[j - 1] = R[j] + static_cast<double>(n - j) * (t[j] - t[j - 1]);
+  for (std::size_t j = 1; j < n; ++j) L[j] = L[j - 1] + static_cast<double>(j) * (t[j] - t[j - 1]);
+  double best = std::numeric_limits<double>::infinity();
+  std::size_t best_j = n;
+  auto consider = [&](std::size_t j) {
+    if (L[j] > 0 && R[j] > 0) {
+      const double g = std::sqrt(L[j]) + std::sqrt(R[j]);
+      if (g < best || (g == best && j < best_j)) best = g, best_j = j;
+    }
+  };
+  consider(std::min(n - 1, static_cast<std::size_t>(pl * static_cast<double>(n))));
+  constexpr std::size_t kBlock = 64;
+  for (std::size_t j0 = 0; j0 < n; j0 += kBlock) {
+    const std::size_t j1 = std::min(n, j0 + kBlock) - 1;
+    if (std::sqrt(L[j0]) + std::sqrt(R[j1]) > best) continue;
+    for (std::size_t j = j0; j <= j1; ++j) consider(j);
+  }
+  if (best_j == n) return false;
+  const double dn = static_cast<double>(n), bestL = L[best_j], bestR = R[best_j];
+  const double s = std::sqrt(bestL * bestR);
+  law.m = t[best_j];
+  law.log_a = std::log(dn) - std::log(bestL + s);
+  law.log_c = std::log(dn) - std::log(bestR + s);
+  return true;
+}
+}  // namespace
+
+namespace {
+struct ReplicateScratch {
+  std::vector<double> y, tail, R, L;
+};
+
+// Whether replicate b of the bootstrap reaches the data's distance D.
+bool replicate_exceeds(const LaplaceFit& fit, double pl, double D, std::size_t n, std::uint64_t seed,
+                       std::uint64_t stream_index, std::size_t b, ReplicateScratch& w) {
+  w.y.resize(n), w.tail.resize(n + 1);
+  Stream s(seed, Purpose::analysis, stream_index, static_cast<std::uint64_t>(b) + 1);
+  sorted_sample(fit.law, s, w.y, w.tail);
+  AsymmetricLaplace law;
+  return replicate_law(w.y, pl, w.R, w.L, law) && ks_distance_reaches(w.y, law, D);
+}
+}  // namespace
+
 LaplaceGof laplace_gof(std::span<const double> sorted, const LaplaceFit& fit, std::size_t bootstrap, std::uint64_t seed,
-                       std::uint64_t stream_index) {
+                       std::uint64_t stream_index, SequentialStop stop) {
   LaplaceGof g;
   g.D = ks_distance(sorted, fit.law);
   g.bootstrap = bootstrap;
-  const std::size_t n = sorted.size();
-  const std::int64_t B = static_cast<std::int64_t>(bootstrap);
-  std::vector<std::uint8_t> exceed(bootstrap, 0);
-#pragma omp parallel
-  {
-    std::vector<double> y(n), tail(n + 1);
-#pragma omp for schedule(dynamic, 1)
-    for (std::int64_t b = 0; b < B; ++b) {
-      Stream s(seed, Purpose::analysis, stream_index, static_cast<std::uint64_t>(b) + 1);
-      sorted_sample(fit.law, s, y, tail);
-      const LaplaceFit fb = fit_asymmetric_laplace_sorted(y);
-      exceed[static_cast<std::size_t>(b)] = ks_distance_reaches(y, fb.law, g.D) ? 1 : 0;
+  const std::size_t n = sorted.size(), B = bootstrap;
+  const double pl = fit.law.c() / (fit.law.a() + fit.law.c());  // P(t < m) of the generating law
+  // Without a stop all B replicates form one parallel batch; with one, batches of one replicate
+  // per thread are decided in replicate order (the replicates past the stop are discarded).
+  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
+  const std::size_t batch = stop.exceedances == 0 ? std::max<std::size_t>(B, 1) : static_cast<std::size_t>(threads);
+  std::vector<ReplicateScratch> scratch(static_cast<std::size_t>(threads));
+  std::vector<std::uint8_t> exceed(B, 0);
+  std::size_t k = 0, done = 0;
+  for (std::size_t b0 = 0; b0 < B && !g.stopped_early; b0 += batch) {
+    const auto b1 = static_cast<std::int64_t>(std::min(B, b0 + batch));
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (b1 - static_cast<std::int64_t>(b0) > 1)
+    for (std::int64_t b = static_cast<std::int64_t>(b0); b < b1; ++b)
+      exceed[static_cast<std::size_t>(b)] =
+          replicate_exceeds(fit, pl, g.D, n, seed, stream_index, static_cast<std::size_t>(b),
+                            scratch[static_cast<std::size_t>(omp_get_thread_num())]) ? 1 : 0;
+    for (std::size_t b = b0; b < static_cast<std::size_t>(b1); ++b) {
+      k += exceed[b], done = b + 1;
+      const double kd = static_cast<double>(k);
+      if (stop.exceedances > 0 && k >= stop.exceedances && kd / static_cast<double>(done) >= stop.alpha &&
+          (kd + 1.0) / (static_cast<double>(B) + 1.0) >= stop.alpha) {
+        g.stopped_early = done < B;
+        break;
+      }
     }
   }
-  std::size_t k = 0;
-  for (auto e : exceed) k += e;
-  g.p = (1.0 + static_cast<double>(k)) / (1.0 + static_cast<double>(bootstrap));
+  g.replicates = done, g.exceedances = k;
+  g.p = g.stopped_early ? static_cast<double>(k) / static_cast<double>(done)
+                        : (1.0 + static_cast<double>(k)) / (1.0 + static_cast<double>(bootstrap));
   return g;
 }
 

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <Random123/uniform.hpp>
+
 #include "asperity/core/geometry.hpp"
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
@@ -26,6 +28,25 @@ TEST(Random, StreamsAreCounterBased) {
     const double u = a.uniform();
     EXPECT_GT(u, 0.0);
     EXPECT_LE(u, 1.0);
+  }
+}
+
+TEST(Random, StreamsAreFixed) {
+  // Every stored result depends on these words (Philox4x64-10 at counter (block, sub), key (seed,
+  // purpose << 56 ^ index)); pinned from the out-of-line implementation before bits() was inlined.
+  Stream a(5, Purpose::test, 17, 3), b(5, Purpose::test, 17, 3);
+  const std::uint64_t want[6] = {0xdf1f3fcca8d066e1ull, 0x22f3cd43cc92c70bull, 0x23d37b86253c4b46ull,
+                                 0x975e452064c0231eull, 0xff545645d3c86d99ull, 0x5b85d1fec3e79d1cull};
+  for (std::uint64_t w : want) {
+    EXPECT_EQ(a.bits(), w);
+    EXPECT_EQ(b.uniform(), r123::u01<double>(w));  // the inline uniform() is Random123's u01
+  }
+  EXPECT_EQ(r123::u01<double>(want[0]), 0x1.be3e7f9951a0dp-1);
+  EXPECT_EQ(r123::u01<double>(~std::uint64_t{0}), 1.0);  // (0, 1]: the top word rounds to 1
+  Stream c(5, Purpose::test, 1);
+  for (int i = 0; i < 100000; ++i) {
+    const std::uint64_t w = c.bits();
+    ASSERT_EQ(static_cast<double>(w) * 0x1p-64 + 0x1p-65, r123::u01<double>(w)) << w;
   }
 }
 

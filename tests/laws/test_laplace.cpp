@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "asperity/laws/laplace.hpp"
+#include "asperity/laws/verdict.hpp"
 #include "asperity/core/random.hpp"
 
 using namespace asperity;
@@ -158,6 +159,87 @@ TEST(Laplace, BootstrapIndependentOfThreads) {
   const auto g2 = laplace_gof(x, f, 40, 3, 9);
   EXPECT_EQ(g1.D, g2.D);
   EXPECT_EQ(g1.p, g2.p);
+}
+
+TEST(Laplace, SequentialStopKeepsTheVerdict) {
+  // The stop may only cut an accepting bootstrap short: over ALD samples (accepted) and Gaussian and
+  // uniform ones (the deliberately wrong laws, rejected), at three alphas, the verdict with the stop is
+  // the verdict of all B; a stopped run drew fewer replicates, saw >= K_stop exceedances and reports
+  // K / L; a run that did not stop reports the exact (1 + K)/(1 + B). The rejected samples never stop.
+  const auto law = truth();
+  Stream s(21, Purpose::test, 0);
+  std::vector<std::vector<double>> samples;
+  for (int r = 0; r < 6; ++r) samples.push_back(draw(law, 1500, 300 + r));
+  std::vector<double> gauss(1500), unif(1500);
+  for (std::size_t i = 0; i < gauss.size(); ++i) {
+    gauss[i] = 0.9 + 3e-6 * std::sqrt(-2 * std::log(s.uniform())) * std::cos(2 * M_PI * s.uniform0());
+    unif[i] = 0.9 + 1e-5 * s.uniform0();
+  }
+  samples.push_back(gauss), samples.push_back(unif);
+  int stopped = 0;
+  for (std::size_t j = 0; j < samples.size(); ++j) {
+    auto& x = samples[j];
+    std::sort(x.begin(), x.end());
+    const auto f = fit_asymmetric_laplace_sorted(x);
+    const auto full = laplace_gof(x, f, 99, 4, j);
+    EXPECT_EQ(full.replicates, 99u);
+    for (double alpha : {0.01, 0.05, 0.2}) {
+      const auto seq = laplace_gof(x, f, 99, 4, j, SequentialStop{5, alpha});
+      EXPECT_EQ(verdict_at(seq.p, alpha), verdict_at(full.p, alpha)) << j << " alpha " << alpha;
+      EXPECT_EQ(seq.D, full.D);
+      if (seq.stopped_early) {
+        ++stopped;
+        EXPECT_LT(seq.replicates, 99u);
+        EXPECT_GE(seq.exceedances, 5u);
+        EXPECT_EQ(seq.p, double(seq.exceedances) / double(seq.replicates));
+        EXPECT_GE(full.p, alpha);
+      } else {
+        EXPECT_EQ(seq.p, full.p);
+      }
+      if (j >= 6) {
+        EXPECT_FALSE(seq.stopped_early) << "a rejected sample stopped early, alpha " << alpha;
+      }
+    }
+  }
+  EXPECT_GE(stopped, 6);  // the stop does happen on accepted samples
+  // Where the stop happens is decided in replicate order: the same for any thread count.
+  omp_set_num_threads(1);
+  const auto f0 = fit_asymmetric_laplace_sorted(samples[0]);
+  const auto g1 = laplace_gof(samples[0], f0, 99, 4, 0, SequentialStop{5, 0.01});
+  omp_set_num_threads(2);
+  const auto g2 = laplace_gof(samples[0], f0, 99, 4, 0, SequentialStop{5, 0.01});
+  EXPECT_EQ(g1.p, g2.p);
+  EXPECT_EQ(g1.replicates, g2.replicates);
+}
+
+TEST(Laplace, SequentialBootstrapIsCalibratedUnderTheNull) {
+  // The same null as BootstrapIsCalibratedUnderTheNull with the stop (K = 5, B = 99): over 300 ALD
+  // samples of n = 400, P(p <= 0.1) = 0.1 within 4 sd (binomial sd 5.2); a p that the stop biased
+  // (e.g. K / L with L counted from 0, or the stop taken at the first exceedance) would move it.
+  const auto law = truth();
+  int low = 0;
+  std::size_t drawn = 0;
+  for (int r = 0; r < 300; ++r) {
+    auto x = draw(law, 400, 1000 + r);
+    std::sort(x.begin(), x.end());
+    const auto g = laplace_gof(x, fit_asymmetric_laplace_sorted(x), 99, 7, r, SequentialStop{5, 0.01});
+    low += g.p <= 0.1 + 1e-12 ? 1 : 0;
+    drawn += g.replicates;
+  }
+  const double sd = std::sqrt(300 * 0.1 * 0.9);
+  EXPECT_LT(std::abs(low - 30), 4 * sd) << low;
+  EXPECT_LT(drawn, 300u * 99u / 2) << "the stop saved less than half the replicates under the null";
+  // The deliberately wrong input: 40 Gaussian samples of the same n must leave the band (P(p <= 0.1)
+  // far above 0.1 + 4 sd; 99 of 100 had p <= 0.1), so the band notices a p that is not calibrated.
+  Stream g(22, Purpose::test, 0);
+  int low_gauss = 0;
+  for (int r = 0; r < 40; ++r) {
+    std::vector<double> x(400);
+    for (auto& v : x) v = 0.9 + 3e-6 * std::sqrt(-2 * std::log(g.uniform())) * std::cos(2 * M_PI * g.uniform0());
+    std::sort(x.begin(), x.end());
+    low_gauss += laplace_gof(x, fit_asymmetric_laplace_sorted(x), 99, 7, 500 + r, SequentialStop{5, 0.01}).p <= 0.1 ? 1 : 0;
+  }
+  EXPECT_GT(low_gauss, 4 + 4 * std::sqrt(40 * 0.1 * 0.9)) << low_gauss;
 }
 
 TEST(Laplace, BadInputNamesTheProblem) {

@@ -21,6 +21,9 @@
 // Binomial(n, 1/2) is drawn exactly without std::binomial_distribution (whose draws differ
 // between library versions): popcount of n random bits for n <= 512, otherwise inversion that
 // starts at the mode and walks outwards (pmf from lgamma, then exact ratios), O(sqrt n) steps.
+// The mode's pmf (three lgamma and an exp) can come from a BinomialModeCache shared by the spheres
+// of a run (the same value, computed once per n).
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -31,8 +34,22 @@ namespace asperity {
 
 class Stream;
 
+/// P(X = floor(n/2)) for X ~ Binomial(n, 1/2), n <= n_max, each value computed on first use and
+/// kept: one cache serves the lazy spheres of all threads of a run (thread-safe; every thread
+/// computes the same value, so whichever stores it first the draws are the same).
+class BinomialModeCache {
+ public:
+  explicit BinomialModeCache(std::uint64_t n_max) : p_(n_max + 1) {}
+  double operator()(std::uint64_t n);
+  std::uint64_t max_n() const { return p_.size() - 1; }
+
+ private:
+  std::vector<std::atomic<double>> p_;  // 0: not computed yet (the mode's pmf is > 0)
+};
+
 /// Binomial(n, 1/2) from the stream (exact: popcount for small n, mode-centred inversion above).
-std::uint64_t binomial_half(std::uint64_t n, Stream& s);
+/// `cache` (optional, any n_max) only saves work: the draw is the same with or without it.
+std::uint64_t binomial_half(std::uint64_t n, Stream& s, BinomialModeCache* cache = nullptr);
 
 struct LazyNearest {
   Nearest nearest;  ///< as brute_lowest on materialise()
@@ -42,7 +59,9 @@ struct LazyNearest {
 class LazySphere {
  public:
   /// N >= 1 (< 2^32, indices are 32-bit) centres; throws std::invalid_argument otherwise.
-  LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size = 8);
+  /// `modes` (optional, must outlive the sphere) is shared work, not state: same sphere without it.
+  LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere_id, unsigned leaf_size = 8,
+             BinomialModeCache* modes = nullptr);
 
   /// Start another sphere (same N): clears the cache, keeps the allocated memory.
   void reset(std::uint64_t seed, std::uint64_t sphere_id);
@@ -65,6 +84,7 @@ class LazySphere {
     // rule's polar extent, computed exactly as before so the sphere is the same sample) and
     // cos, sin of p0, p1 (the bound's phi part without a cos per call).
     double t0, t1, c0, s0, c1, s1;
+    double r0, r1;  // sqrt(1 - z^2) at z0, z1 (the bound's and the split rule's, without a sqrt per call)
     std::uint64_t id;      // heap numbering: root 1, children 2 id and 2 id + 1
     std::uint64_t count;   // centres in the cell
     std::uint64_t offset;  // global index of its first centre
@@ -82,6 +102,7 @@ class LazySphere {
 
   std::uint64_t n_, seed_, sphere_;
   unsigned leaf_size_;
+  BinomialModeCache* modes_;
   std::vector<Node> nodes_;
   std::vector<Vec3> points_;
   std::vector<std::pair<double, std::size_t>> heap_;  // scratch of lowest()

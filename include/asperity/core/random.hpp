@@ -29,11 +29,14 @@ class Stream {
   /// independent streams.
   Stream(std::uint64_t seed, Purpose purpose, std::uint64_t index, std::uint64_t sub = 0) noexcept;
 
-  /// Uniform double in (0, 1]: never 0, so log(u) is always finite.
-  double uniform() noexcept;
+  /// Uniform double in (0, 1]: never 0, so log(u) is always finite. Random123's u01:
+  /// bits 2^-64 + 2^-65 (the product is exact, so a fused multiply-add gives the same value).
+  double uniform() noexcept { return static_cast<double>(bits()) * 0x1p-64 + 0x1p-65; }
   /// Uniform double in [0, 1).
   double uniform0() noexcept { return 1.0 - uniform(); }
-  std::uint64_t bits() noexcept;
+  /// Inline: the lazy sphere and the bootstrap draw ~10^8 of these per run; only every fourth
+  /// call generates a Philox block (out of line).
+  std::uint64_t bits() noexcept { return left_ ? buf_[4 - left_--] : refill(); }
 
  private:
   std::uint64_t key_[2];
@@ -41,6 +44,7 @@ class Stream {
   std::uint64_t block_ = 0;  // counter of the next Philox block
   std::uint64_t buf_[4] = {0, 0, 0, 0};
   int left_ = 0;
+  std::uint64_t refill() noexcept;  // next block into buf_, returns its first word
 };
 
 }  // namespace asperity

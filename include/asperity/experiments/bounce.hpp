@@ -76,6 +76,10 @@ struct BounceExperiment {
   unsigned max_impacts = 100000;  ///< safety bound per sequence
   std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
                                   ///< max(19, 2e7/n): the work is B n; the count used is reported)
+  /// Sequential stop of that bootstrap (laplace.hpp SequentialStop): after this many replicates at
+  /// or beyond the data's D, once the verdict can only be "accept", p is estimated as K / L from
+  /// the L replicates drawn; the verdicts are those of all B. 0: always all B (exact p).
+  std::size_t bootstrap_stop = 10;
   /// Level of the goodness-of-fit verdicts: a group whose bootstrap found no replicate as far from
   /// its fit as the data (p at its floor 1/(1+B)) while 1/(1+B) >= alpha is undecided.
   double alpha = 0.01;

@@ -67,14 +67,31 @@ LaplaceFit fit_asymmetric_laplace_sorted(std::span<const double> sorted);
 
 struct LaplaceGof {
   double D = 0;               ///< KS distance of the sample to its fitted law
-  double p = 1;               ///< parametric-bootstrap p-value: (1 + #{D_b >= D}) / (1 + B)
-  std::size_t bootstrap = 0;  ///< B
+  /// parametric-bootstrap p-value: (1 + #{D_b >= D}) / (1 + B); after a sequential stop
+  /// (stopped_early) the estimate K / L from the L replicates drawn, K of them >= D.
+  double p = 1;
+  std::size_t bootstrap = 0;  ///< B (the budget)
+  std::size_t replicates = 0;   ///< L: replicates drawn (B unless stopped_early)
+  std::size_t exceedances = 0;  ///< K: replicates with D_b >= D among them
+  bool stopped_early = false;
+};
+
+/// When the bootstrap may stop before B replicates: once K >= `exceedances` replicates reached D
+/// and both K / L and (K + 1)/(B + 1) are >= alpha. The p of all B replicates could then only be
+/// (K_B + 1)/(B + 1) >= (K + 1)/(B + 1) >= alpha: the verdict at alpha (accept) is the one all B
+/// would give, and K / L estimates p (relative se ~ 1/sqrt(K), Besag & Clifford 1991). A test
+/// heading for rejection never stops early. exceedances = 0: always all B.
+struct SequentialStop {
+  std::size_t exceedances = 0;
+  double alpha = 0;
 };
 
 /// KS of the sample against its own fit with a parametric-bootstrap p-value. Replicate b draws n
 /// values from Stream(seed, Purpose::analysis, stream_index, b + 1), refits and computes D_b;
-/// replicates run in parallel and the result is the same for any thread count.
+/// replicates run in parallel (on one thread when called inside a parallel region) and the result,
+/// including where a sequential stop happens (decided in replicate order), is the same for any
+/// thread count.
 LaplaceGof laplace_gof(std::span<const double> sorted, const LaplaceFit& fit, std::size_t bootstrap,
-                       std::uint64_t seed, std::uint64_t stream_index);
+                       std::uint64_t seed, std::uint64_t stream_index, SequentialStop stop = {});
 
 }  // namespace asperity
