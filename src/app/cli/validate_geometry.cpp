@@ -22,6 +22,7 @@
 #include "asperity/app/checkpoint.hpp"
 #include "asperity/app/interrupt.hpp"
 #include "asperity/app/output_staging.hpp"
+#include "asperity/app/plan.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/app/resources.hpp"
@@ -39,6 +40,18 @@ using asperity::cli::ProgressLine;
 
 namespace {
 
+// Whether run_scene will stream this scene: the planned ensemble decides, as in run_scene (only
+// such runs are split across processes). A scene that does not validate is refused later, with
+// validate's message.
+bool streams(const Scene& s) {
+  if (run_kind(s) != RunKind::sphere) return false;
+  try {
+    return uses_streaming(make_plan(s).scene.ensemble);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+}
+
 // The command line, checked as far as it can be before the output directory is touched. Returns
 // the exit status when the run ends here (--help: 0; bad input: 2). `share`: this process's share
 // of a split run (its checkpoint file is checked); only rank 0 prints help and errors.
@@ -52,7 +65,7 @@ std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& 
       return 0;
     }
     scene = o.scene;
-    scene.share = uses_streaming(scene.ensemble) && !scene.bounce.enabled && !scene.mesh && !scene.radii ? share : StreamShare{};
+    scene.share = share.ranks > 1 && streams(scene) ? share : StreamShare{};
     quiet = o.quiet || share.rank > 0;
     if (scene.plots && !plotting_available())
       throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
