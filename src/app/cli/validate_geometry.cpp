@@ -67,7 +67,7 @@ std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& 
     scene = o.scene;
     scene.share = share.ranks > 1 && streams(scene) ? share : StreamShare{};
     quiet = o.quiet || share.rank > 0;
-    if (scene.plots && !plotting_available())
+    if (scene.plots && share.rank == 0 && !plotting_available())  // only rank 0 draws
       throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
     check_scene_inputs(scene);
     check_memory(scene);
