@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,20 @@ struct CommandResult {
   int status;
   std::string out;
 };
+
+/// A file's bytes ("" if it cannot be read).
+inline std::string slurp(const std::filesystem::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// An empty path in the temporary directory for one test: asperity-<what>-<name>-<pid>, removed if
+/// a previous run left it.
+inline std::filesystem::path fresh_dir(const std::string& what, const std::string& name) {
+  const auto d = std::filesystem::temp_directory_path() / ("asperity-" + what + "-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  return d;
+}
 
 inline CommandResult run_command(const std::string& cmd) {
   FILE* p = popen(cmd.c_str(), "r");

@@ -333,8 +333,10 @@ ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run,
     status = 2, error = ex.what();
   }
   if (group) status = group->max(status);
-  if (status == 2)
-    throw std::runtime_error(error.empty() ? "another process of this run failed (its message is above)" : error);
+  if (status == 2) {
+    if (error.empty()) throw StreamEnded("another process of this run failed (its message is above)");
+    throw std::runtime_error(error);
+  }
   if (status == 1) {
     if (cs.complete) h.checkpoint(cs.state);
     const std::string where = (s.out / checkpoint_state_name(s.share)).string();
@@ -344,7 +346,7 @@ ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run,
                 << ": continue with " << (s.share.ranks > 1 ? "mpirun -np " + std::to_string(s.share.ranks) + " " : "")
                 << "validate-geometry --resume " << s.out.string() << "\n";
     defer.reset();  // a pending signal ends the process here
-    throw std::runtime_error("the streaming run stopped before its last drop; checkpoint in " + where);
+    throw StreamEnded("the streaming run stopped before its last drop; checkpoint in " + where);
   }
   if (group) gather_shares(cs, *group);
   return cs;

@@ -19,37 +19,22 @@
 
 #include "asperity/app/scene.hpp"
 #include "asperity/app/scene_file.hpp"
+#include "comparable_report.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
+using asperity::testing::comparable_report;
 using asperity::testing::run_command;
+using asperity::testing::slurp;
 
 namespace {
 
 std::string vg() { return VALIDATE_GEOMETRY; }
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("asperity-checkpoint-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  return d;
-}
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+fs::path fresh_dir(const std::string& name) { return asperity::testing::fresh_dir("checkpoint", name); }
 
 pid_t spawn(const std::vector<std::string>& args, const fs::path& log) { return asperity::testing::spawn_cli(vg(), args, log); }
 using asperity::testing::wait_status;
-
-// The report without what may differ between an interrupted-and-resumed run and a whole one.
-nlohmann::json comparable(const fs::path& report) {
-  auto j = nlohmann::json::parse(slurp(report));
-  for (const char* k : {"timings_s", "plan", "scene_file"}) j.erase(k);
-  return j;
-}
 
 // 10^6 explicit drops at N = 10^3 (2500 spheres x 400 rotations): 4 waves of streaming statistics.
 std::vector<std::string> run_args(const fs::path& out) {
@@ -94,7 +79,7 @@ TEST(Checkpoint, SigtermThenResumeEqualsTheUninterruptedRun) {
   r = run_command(vg() + " -q --resume " + cut.string() + " --threads 1 2>&1");
   EXPECT_EQ(r.status, whole_status) << r.out;
   EXPECT_FALSE(fs::exists(cut / "checkpoint.bin"));
-  EXPECT_EQ(comparable(cut / "report.json"), comparable(whole / "report.json"));
+  EXPECT_EQ(comparable_report(cut / "report.json"), comparable_report(whole / "report.json"));
   fs::remove_all(whole);
   fs::remove_all(cut);
   fs::remove(log);

@@ -33,10 +33,7 @@ fs::path fresh_dir(const std::string& name) {
   return d;
 }
 
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using asperity::testing::slurp;
 
 // Every entry of a directory (recursively) with its bytes ("<dir>" for directories).
 std::map<std::string, std::string> snapshot(const fs::path& dir) {

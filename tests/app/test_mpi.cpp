@@ -17,33 +17,19 @@
 
 #include <nlohmann/json.hpp>
 
+#include "comparable_report.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
+using asperity::testing::comparable_report;
 using asperity::testing::run_command;
+using asperity::testing::slurp;
 
 namespace {
 
 const std::string kMpirun = std::string(MPIEXEC) + " --allow-run-as-root --oversubscribe --mca btl self,vader";
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("asperity-mpi-" + name + "-" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  return d;
-}
-
-std::string slurp(const fs::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-nlohmann::json comparable(const fs::path& report) {
-  auto j = nlohmann::json::parse(slurp(report));
-  for (const char* k : {"timings_s", "plan", "scene_file"}) j.erase(k);
-  return j;
-}
+fs::path fresh_dir(const std::string& name) { return asperity::testing::fresh_dir("mpi", name); }
 
 // 2e6 explicit drops at N = 10^3 (5000 spheres x 400 rotations, 256 blocks): 4 waves per process.
 std::string run_args(const fs::path& out) {
@@ -59,7 +45,7 @@ TEST(Mpi, TwoProcessesWriteTheReportOfOneAndResumeFromTheirCheckpoints) {
   ASSERT_TRUE(status == 0 || status == 1) << r.out;
   r = run_command(kMpirun + " -np 2 " + VALIDATE_GEOMETRY + run_args(two) + " --threads 1 2>&1");
   ASSERT_EQ(r.status, status) << r.out;
-  EXPECT_EQ(comparable(two / "report.json"), comparable(one / "report.json"));
+  EXPECT_EQ(comparable_report(two / "report.json"), comparable_report(one / "report.json"));
   EXPECT_FALSE(fs::exists(two / "checkpoint.toml")) << "a completed run leaves no checkpoint";
 
   // Interrupted: each process writes its share's checkpoint once SIGTERM reaches it through mpirun.
@@ -83,7 +69,7 @@ TEST(Mpi, TwoProcessesWriteTheReportOfOneAndResumeFromTheirCheckpoints) {
   EXPECT_NE(r.out.find("mpirun -np P"), std::string::npos) << r.out;
   r = run_command(kMpirun + " -np 2 " + VALIDATE_GEOMETRY + " -q --resume " + cut.string() + " --threads 1 2>&1");
   EXPECT_EQ(r.status, status) << r.out;
-  EXPECT_EQ(comparable(cut / "report.json"), comparable(one / "report.json"));
+  EXPECT_EQ(comparable_report(cut / "report.json"), comparable_report(one / "report.json"));
   EXPECT_FALSE(fs::exists(r0) || fs::exists(r1) || fs::exists(cut / "checkpoint.toml"));
   for (const auto& d : {one, two, cut}) fs::remove_all(d);
   fs::remove(log);

@@ -3,6 +3,7 @@
 // as analyse() gives for raw samples, with tests evaluated on the binned data (laws/binned.hpp),
 // each row naming its statistic and resolution; report.json "statistics" says which path ran.
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,12 @@ void write_band_png(const std::filesystem::path& png, const BandFigure& fig);
 GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
                                 const StreamHooks& hooks = {}, const StreamState* resume = nullptr,
                                 Collective* group = nullptr);
+
+/// A streaming run that ended without a result for a reason already told: a signal stopped it (its
+/// checkpoint is written) or another process of a split run failed (that process said why).
+struct StreamEnded : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 /// A process of rank > 0 of a split run: runs its share s.share of the planned stream (with its own
 /// checkpoints) and sends it to rank 0. Throws as rank 0's run does when any process failed or

@@ -182,10 +182,10 @@ int run_split(const Scene& scene, bool quiet, Collective& world) {
   } else if (split) {
     try {
       run_stream_share(scene, group);
+    } catch (const StreamEnded&) {
+      status = 2;  // told already: by rank 0 (a stop) or by the process that failed
     } catch (const std::exception& ex) {
-      const std::string what = ex.what();
-      if (what.find("another process") == std::string::npos && what.find("stopped before") == std::string::npos)
-        std::cerr << "validate-geometry: error (rank " << group.rank() << "): " << what << "\n";
+      std::cerr << "validate-geometry: error (rank " << group.rank() << "): " << ex.what() << "\n";
       status = 2;
     }
   }
