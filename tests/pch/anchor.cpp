@@ -1,0 +1,2 @@
+// Compiles the tests' precompiled header (tests/CMakeLists.txt, asperity_test_pch) once for
+// every test executable; nothing of its own.
