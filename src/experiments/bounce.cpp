@@ -73,6 +73,7 @@ void validate(const BounceExperiment& b) {
     if (k < 1) throw std::invalid_argument("bounce: impact numbers start at 1, got 0");
   if (!std::isfinite(b.alpha) || !(b.alpha > 0) || !(b.alpha < 1))
     throw std::invalid_argument("bounce: alpha must be in (0, 1), got " + num(b.alpha));
+  if (b.bootstrap_draws < 1) throw std::invalid_argument("bounce: bootstrap_draws must be >= 1");
 }
 
 namespace {
@@ -456,7 +457,7 @@ void group_moments(const GroupSums& t, BounceGroup& g) {
 std::size_t bootstrap_count(const BounceExperiment& b, std::size_t n) {
   const auto B_floor = static_cast<std::size_t>(std::ceil(1.0 / b.alpha - 1e-9));
   return b.bootstrap == 0 ? 0
-                          : std::min<std::size_t>(std::max(b.bootstrap, B_floor), std::max<std::size_t>(19, 20000000 / n));
+                          : std::min<std::size_t>(std::max(b.bootstrap, B_floor), std::max<std::uint64_t>(19, b.bootstrap_draws / n));
 }
 
 // Eq. 2 fitted to the (sorted) group and its parametric-bootstrap KS test.
@@ -466,7 +467,7 @@ void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t i
     g.fit = fit_asymmetric_laplace_sorted(g.sorted);
     g.fitted = true;
     // B adapts up to the smallest count whose floor 1/(1+B) is below alpha (ceil(1/alpha): 100 at
-    // alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
+    // alpha = 0.01; B = 99 could never reject), within a work budget B n <= bootstrap_draws (B >= 19)
     // for the big low-speed windows; a group left with floor >= alpha is undecided when no
     // replicate reaches D (below), never accepted.
     const std::size_t B = bootstrap_count(b, g.n);

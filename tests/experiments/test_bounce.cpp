@@ -245,9 +245,10 @@ TEST(Bounce, SecVPaperProcedureHasTheMarginalButKeepsTheSpinSign) {
 TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
   // A Gaussian sample of 4000 is not Laplace (KS D ~ 0.03, far beyond the bootstrap's replicates).
   // B adapts to ceil(1/alpha) so that the floor 1/(1+B) is below alpha: at alpha = 0.01 a requested
-  // B = 19 becomes 100 and the misfit is rejected (p = 1/101). Where the work budget B n <= 2e7 caps
-  // B below that (alpha = 1e-4 needs 10^4 replicates, the budget allows 5000 at n = 4000) the group is
-  // undecided ("cannot decide at this B"), never accepted. A Laplace sample is accepted.
+  // B = 19 becomes 100 and the misfit is rejected (p = 1/101). Where the work budget B n caps B below
+  // that (alpha = 1e-4 needs 10^4 replicates; a budget of 2e5 draws allows 50 at n = 4000, the
+  // default 2e7 would allow 5000: the same rule, 100x cheaper to test) the group is undecided
+  // ("cannot decide at this B"), never accepted. A Laplace sample is accepted.
   auto make = [](bool laplace) {
     BounceSamples s;
     s.variant = BounceVariant::paper_corrected28;
@@ -269,12 +270,13 @@ TEST(Bounce, BootstrapFloorAboveAlphaIsNoVerdict) {
   ASSERT_EQ(r.groups.size(), 1u);
   EXPECT_EQ(r.groups[0].gof.bootstrap, 100u);
   EXPECT_EQ(r.groups[0].gof_verdict, Verdict::reject) << "p = " << r.groups[0].gof.p;
-  b.alpha = 1e-4;
+  b.alpha = 1e-4, b.bootstrap_draws = 200000;
+  EXPECT_EQ(BounceExperiment{}.bootstrap_draws, 20000000u);
   r = analyse_bounces(gauss, b, 7);
-  EXPECT_EQ(r.groups[0].gof.bootstrap, 5000u);
-  EXPECT_NEAR(r.groups[0].gof.p, 1.0 / 5001, 1e-15);
+  EXPECT_EQ(r.groups[0].gof.bootstrap, 50u);
+  EXPECT_NEAR(r.groups[0].gof.p, 1.0 / 51, 1e-15);
   EXPECT_EQ(r.groups[0].gof_verdict, Verdict::undecided);
-  b.alpha = 0.01;
+  b.alpha = 0.01, b.bootstrap_draws = BounceExperiment{}.bootstrap_draws;
   r = analyse_bounces(make(true), b, 7);
   EXPECT_EQ(r.groups[0].gof_verdict, Verdict::accept) << "p = " << r.groups[0].gof.p;
 }

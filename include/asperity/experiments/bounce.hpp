@@ -75,7 +75,9 @@ struct BounceExperiment {
   TangentialLaw tangential;
   unsigned max_impacts = 100000;  ///< safety bound per sequence
   std::size_t bootstrap = 99;     ///< replicates of the goodness-of-fit bootstrap (per group at most
-                                  ///< max(19, 2e7/n): the work is B n; the count used is reported)
+                                  ///< max(19, bootstrap_draws/n): the work is B n; the count used is reported)
+  /// The work budget B n of one group's bootstrap (draws); big low-speed windows get fewer replicates.
+  std::uint64_t bootstrap_draws = 20000000;
   /// Sequential stop of that bootstrap (laplace.hpp SequentialStop): after this many replicates at
   /// or beyond the data's D, once the verdict can only be "accept", p is estimated as K / L from
   /// the L replicates drawn; the verdicts are those of all B. 0: always all B (exact p).
