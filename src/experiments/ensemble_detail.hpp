@@ -16,6 +16,13 @@
 
 namespace asperity::detail {
 
+/// The rotation of explicit drop `drop` (index k m + j): Marsaglia's trig-free Haar draw from the
+/// drop's own stream. Shared by the drop loop and the streaming run's cross-check.
+inline Rotation drop_rotation(const EnsembleConfig& c, std::uint64_t drop) {
+  Stream st(c.seed, Purpose::orientation, drop);
+  return random_rotation_marsaglia(st);
+}
+
 /// Rotations [b, e) of sphere k (m rotations per sphere): drop k m + j, one Haar rotation from
 /// its own stream, the lowest asperity by one batched query. The one definition of an explicit
 /// drop, so that both drivers see the same drops. `each(j, contact, down, nearest)` per rotation,
@@ -31,8 +38,7 @@ void query_rotations(const EnsembleConfig& c, std::uint64_t m, std::span<const V
   for (std::uint64_t lo = b; lo < e; lo += kQueryBatch) {
     const std::size_t n = static_cast<std::size_t>(std::min(kQueryBatch, e - lo));
     for (std::size_t i = 0; i < n; ++i) {
-      Stream st(c.seed, Purpose::orientation, k * m + lo + i);
-      q[i] = random_rotation(st);
+      q[i] = drop_rotation(c, k * m + lo + i);
       d[i] = body_down(q[i]);
     }
     index.lowest(std::span<const Vec3>(d.data(), n), std::span<Nearest>(nn.data(), n));

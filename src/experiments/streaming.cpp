@@ -142,8 +142,7 @@ struct Driver {
   detail::SphereCheck check(const Built& b, std::uint64_t k) const {
     std::vector<std::pair<Vec3, Nearest>> answers;
     for (std::uint64_t r = 0; r < m && answers.size() < plan.per_sphere; r += plan.stride) {
-      Stream st(c.seed, Purpose::orientation, k * m + r);
-      const Vec3 d = body_down(random_rotation(st));
+      const Vec3 d = body_down(detail::drop_rotation(c, k * m + r));
       answers.emplace_back(d, b.index->lowest(d));
     }
     return detail::cross_check_sphere(c, b.body.centres, answers, plan.others, k);
