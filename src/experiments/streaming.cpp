@@ -35,8 +35,9 @@ constexpr std::uint64_t kLongSphereUnits = 1024;          // more units (4e6 rot
 constexpr std::uint64_t kWaveDrops = 1 << 18; // small spheres: at most this many drops per wave (or one sphere)
 constexpr std::size_t kQ = 3;                 // r_xy, r_x, r_y
 
+// One unit's moments, as sums about each quantity's reference mean (Sink::ref_mean): no division per drop.
 struct Slot {
-  Moments m[kQ];
+  ShiftedSums m[kQ];
   std::uint64_t core = 0;
 };
 
@@ -51,13 +52,16 @@ struct Sink {
   std::vector<std::vector<std::uint64_t>> fine;  // thread t, quantity q at t * kQ + q
   std::vector<std::vector<std::uint64_t>> cell;  // thread t: quantity q's coarse bin c at q C + c
   std::vector<std::size_t> cell_block;           // thread t: the block its cells count, or kNoBlock
+  double ref_mean[kQ];                           // per quantity: its reference law's mean (moments shift)
   std::uint64_t K = 0, G = 0;
   std::size_t block(std::uint64_t k) const { return static_cast<std::size_t>(k * G / K); }
 
   Sink(std::vector<BinnedStats>& s, std::vector<const FineBinner*> b, std::size_t threads, std::uint64_t spheres)
       : stats(s), bin(std::move(b)), fine(threads * kQ, std::vector<std::uint64_t>(s[0].fine_bins(), 0)),
         cell(threads, std::vector<std::uint64_t>(kQ * s[0].coarse_bins(), 0)), cell_block(threads, kNoBlock),
-        K(spheres), G(s[0].blocks) {}
+        K(spheres), G(s[0].blocks) {
+    for (std::size_t q = 0; q < kQ; ++q) ref_mean[q] = s[q].ref.mean();
+  }
 
   void count(int t, std::size_t g, const Contact& ct, Slot& slot) {
     const auto ti = static_cast<std::size_t>(t);
@@ -70,7 +74,7 @@ struct Sink {
       const std::size_t f = (*bin[q])(x[q]);
       ++fine[ti * kQ + q][f];
       ++cells[q * C + (f >> shift)];
-      slot.m[q].add(x[q]);
+      slot.m[q].add(x[q], ref_mean[q]);
     }
     slot.core += ct.core ? 1 : 0;
   }
@@ -172,7 +176,7 @@ void merge_slots(StreamState& st, const Sink& sink, const std::vector<Slot>& slo
                  std::uint64_t units_per_sphere) {
   for (std::size_t i = 0; i < slots.size(); ++i) {
     const std::size_t g = sink.block((first_unit + i) / units_per_sphere);
-    for (std::size_t q = 0; q < kQ; ++q) st.stats[q].block_moments[g].merge(slots[i].m[q]);
+    for (std::size_t q = 0; q < kQ; ++q) st.stats[q].block_moments[g].merge(slots[i].m[q].moments(sink.ref_mean[q]));
     st.core_contacts += slots[i].core;
   }
 }
