@@ -90,6 +90,7 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr int kRowSlots = 8;
 constexpr double kPerCell = 1.3;
 constexpr std::size_t kPad = kRowSlots + 4;  // readable slots past the last point
+constexpr std::size_t kResidentBytes = std::size_t{1} << 20;  // batched queries without prefetch up to this
 
 /// Allocator for the big arrays: 2 MiB-aligned and, on Linux, backed by transparent huge pages
 /// when available, so that the random accesses of the queries do not miss the TLB each time.
@@ -289,6 +290,12 @@ class Grid final : public ContactQuery {
 
   void lowest(std::span<const Vec3> d, std::span<Nearest> out) const override {
     if (out.size() != d.size()) throw std::invalid_argument("lowest(): output size differs from input size");
+    // An index that fits in a core's L2 is answered query by query: the pipeline's prefetches
+    // then only cost instructions (N = 10^4: -8% CPU per drop; at N = 3x10^4, 1.6 MB, they pay).
+    if (memory_bytes() <= kResidentBytes) {
+      for (std::size_t q = 0; q < d.size(); ++q) out[q] = lowest(d[q]);
+      return;
+    }
     // Software pipeline: query q is located (and its cell starts prefetched) at step q, its points
     // are prefetched at step q + kLag, and it is searched at step q + 2 kLag.
     constexpr std::size_t kLag = 8, kRing = 32;  // >= 2 kLag + 1; a power of two: % is a mask
