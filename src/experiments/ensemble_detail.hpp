@@ -42,7 +42,12 @@ void query_rotations(const EnsembleConfig& c, std::uint64_t m, std::span<const V
       d[i] = body_down(q[i]);
     }
     index.lowest(std::span<const Vec3>(d.data(), n), std::span<Nearest>(nn.data(), n));
+    // The touching asperity's centre is a random read of the centres (N = 10^5: 2.4 MB, a cache
+    // miss per drop, ~17% of the run): prefetched kCentreLag drops ahead.
+    constexpr std::size_t kCentreLag = 16;
+    for (std::size_t i = 0; i < std::min(n, kCentreLag); ++i) __builtin_prefetch(centres.data() + nn[i].index);
     for (std::size_t i = 0; i < n; ++i) {
+      if (i + kCentreLag < n) __builtin_prefetch(centres.data() + nn[i + kCentreLag].index);
       const Nearest& r = nn[i];
       each(lo + i, make_contact(r, centres[r.index], q[i], c.sphere.radius, c.sphere.asperity_radius), d[i], r);
     }
