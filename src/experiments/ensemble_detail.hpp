@@ -16,6 +16,13 @@
 
 namespace asperity::detail {
 
+/// The rotation of explicit drop `drop` (index k m + j): Marsaglia's trig-free Haar draw from the
+/// drop's own stream. Shared by the drop loop and the streaming run's cross-check.
+inline Rotation drop_rotation(const EnsembleConfig& c, std::uint64_t drop) {
+  Stream st(c.seed, Purpose::orientation, drop);
+  return random_rotation_marsaglia(st);
+}
+
 /// Rotations [b, e) of sphere k (m rotations per sphere): drop k m + j, one Haar rotation from
 /// its own stream, the lowest asperity by one batched query. The one definition of an explicit
 /// drop, so that both drivers see the same drops. `each(j, contact, down, nearest)` per rotation,
@@ -31,12 +38,16 @@ void query_rotations(const EnsembleConfig& c, std::uint64_t m, std::span<const V
   for (std::uint64_t lo = b; lo < e; lo += kQueryBatch) {
     const std::size_t n = static_cast<std::size_t>(std::min(kQueryBatch, e - lo));
     for (std::size_t i = 0; i < n; ++i) {
-      Stream st(c.seed, Purpose::orientation, k * m + lo + i);
-      q[i] = random_rotation(st);
+      q[i] = drop_rotation(c, k * m + lo + i);
       d[i] = body_down(q[i]);
     }
     index.lowest(std::span<const Vec3>(d.data(), n), std::span<Nearest>(nn.data(), n));
+    // The touching asperity's centre is a random read of the centres (N = 10^5: 2.4 MB, a cache
+    // miss per drop, ~17% of the run): prefetched kCentreLag drops ahead.
+    constexpr std::size_t kCentreLag = 16;
+    for (std::size_t i = 0; i < std::min(n, kCentreLag); ++i) __builtin_prefetch(centres.data() + nn[i].index);
     for (std::size_t i = 0; i < n; ++i) {
+      if (i + kCentreLag < n) __builtin_prefetch(centres.data() + nn[i + kCentreLag].index);
       const Nearest& r = nn[i];
       each(lo + i, make_contact(r, centres[r.index], q[i], c.sphere.radius, c.sphere.asperity_radius), d[i], r);
     }

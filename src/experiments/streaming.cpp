@@ -35,29 +35,42 @@ constexpr std::uint64_t kLongSphereUnits = 1024;          // more units (4e6 rot
 constexpr std::uint64_t kWaveDrops = 1 << 18; // small spheres: at most this many drops per wave (or one sphere)
 constexpr std::size_t kQ = 3;                 // r_xy, r_x, r_y
 
+// One unit's moments, as sums about each quantity's reference mean (Sink::ref_mean): no division per drop.
 struct Slot {
-  Moments m[kQ];
+  ShiftedSums m[kQ];
   std::uint64_t core = 0;
 };
 
 // What the threads of a wave write into: fine counts into their own histograms (folded into the
 // state at checkpoints and at the end), coarse counts of their current block into their own cells
 // (added atomically -- integers: any order -- when the block changes and at fold()), moments into
-// their slot. So a drop costs no atomic operation and no transcendental function.
+// their slot. So a drop costs no atomic operation and no transcendental function. The fine
+// histograms (3 x 2^16 x 8 bytes per thread) do not fit in L2 with the index: a drop's three
+// increments are made kLag drops later, after a prefetch of their lines (integer counts: the
+// order does not matter). Whoever counts on thread t calls drain(t) before its counts are read.
 struct Sink {
   static constexpr std::size_t kNoBlock = ~std::size_t{0};
+  static constexpr std::size_t kLag = 16;
+  struct alignas(64) Pending {
+    std::uint32_t f[kLag][kQ];
+    std::size_t n = 0;  // drops staged since the last drain
+  };
   std::vector<BinnedStats>& stats;
   std::vector<const FineBinner*> bin;            // per quantity
   std::vector<std::vector<std::uint64_t>> fine;  // thread t, quantity q at t * kQ + q
   std::vector<std::vector<std::uint64_t>> cell;  // thread t: quantity q's coarse bin c at q C + c
   std::vector<std::size_t> cell_block;           // thread t: the block its cells count, or kNoBlock
+  std::vector<Pending> pending;                  // thread t: fine bins not yet counted
+  double ref_mean[kQ];                           // per quantity: its reference law's mean (moments shift)
   std::uint64_t K = 0, G = 0;
   std::size_t block(std::uint64_t k) const { return static_cast<std::size_t>(k * G / K); }
 
   Sink(std::vector<BinnedStats>& s, std::vector<const FineBinner*> b, std::size_t threads, std::uint64_t spheres)
       : stats(s), bin(std::move(b)), fine(threads * kQ, std::vector<std::uint64_t>(s[0].fine_bins(), 0)),
         cell(threads, std::vector<std::uint64_t>(kQ * s[0].coarse_bins(), 0)), cell_block(threads, kNoBlock),
-        K(spheres), G(s[0].blocks) {}
+        pending(threads), K(spheres), G(s[0].blocks) {
+    for (std::size_t q = 0; q < kQ; ++q) ref_mean[q] = s[q].ref.mean();
+  }
 
   void count(int t, std::size_t g, const Contact& ct, Slot& slot) {
     const auto ti = static_cast<std::size_t>(t);
@@ -66,13 +79,26 @@ struct Sink {
     const unsigned shift = stats[0].fine_log2 - stats[0].coarse_log2;
     const std::size_t C = stats[0].coarse_bins();
     const double x[kQ] = {ct.r_xy, ct.r.x(), ct.r.y()};
+    Pending& p = pending[ti];
+    std::uint32_t* staged = p.f[p.n % kLag];
     for (std::size_t q = 0; q < kQ; ++q) {
       const std::size_t f = (*bin[q])(x[q]);
-      ++fine[ti * kQ + q][f];
+      std::uint64_t* h = fine[ti * kQ + q].data();
+      if (p.n >= kLag) ++h[staged[q]];
+      staged[q] = static_cast<std::uint32_t>(f);
+      __builtin_prefetch(h + f, 1);
       ++cells[q * C + (f >> shift)];
-      slot.m[q].add(x[q]);
+      slot.m[q].add(x[q], ref_mean[q]);
     }
+    ++p.n;
     slot.core += ct.core ? 1 : 0;
+  }
+  void drain(int t) {
+    const auto ti = static_cast<std::size_t>(t);
+    Pending& p = pending[ti];
+    for (std::size_t i = 0; i < std::min(p.n, kLag); ++i)
+      for (std::size_t q = 0; q < kQ; ++q) ++fine[ti * kQ + q][p.f[i][q]];
+    p.n = 0;
   }
   void flush(std::size_t t) {
     const std::size_t g = cell_block[t], C = stats[0].coarse_bins();
@@ -127,6 +153,7 @@ struct Driver {
                             [&](std::uint64_t, const Contact& contact, const Vec3&, const Nearest&) {
                               sink.count(t, g, contact, slot);
                             });
+    sink.drain(t);
   }
 
   // Sampled: "sphere" k is drop k, from the exact law of the lowest asperities (no geometry).
@@ -135,6 +162,7 @@ struct Driver {
     const Nearest nn = brute_lowest(cap, Vec3(0, 0, -1));
     sink.count(t, sink.block(k),
                make_contact(nn, cap[nn.index], Rotation::Identity(), c.sphere.radius, c.sphere.asperity_radius), slot);
+    sink.drain(t);
   }
 
   // The run's queries of a checked sphere (rotations j % stride == 0, the first per_sphere), asked
@@ -142,8 +170,7 @@ struct Driver {
   detail::SphereCheck check(const Built& b, std::uint64_t k) const {
     std::vector<std::pair<Vec3, Nearest>> answers;
     for (std::uint64_t r = 0; r < m && answers.size() < plan.per_sphere; r += plan.stride) {
-      Stream st(c.seed, Purpose::orientation, k * m + r);
-      const Vec3 d = body_down(random_rotation(st));
+      const Vec3 d = body_down(detail::drop_rotation(c, k * m + r));
       answers.emplace_back(d, b.index->lowest(d));
     }
     return detail::cross_check_sphere(c, b.body.centres, answers, plan.others, k);
@@ -173,7 +200,7 @@ void merge_slots(StreamState& st, const Sink& sink, const std::vector<Slot>& slo
                  std::uint64_t units_per_sphere) {
   for (std::size_t i = 0; i < slots.size(); ++i) {
     const std::size_t g = sink.block((first_unit + i) / units_per_sphere);
-    for (std::size_t q = 0; q < kQ; ++q) st.stats[q].block_moments[g].merge(slots[i].m[q]);
+    for (std::size_t q = 0; q < kQ; ++q) st.stats[q].block_moments[g].merge(slots[i].m[q].moments(sink.ref_mean[q]));
     st.core_contacts += slots[i].core;
   }
 }

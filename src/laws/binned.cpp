@@ -26,6 +26,20 @@ void Moments::merge(const Moments& o) {
   n += o.n;
 }
 
+Moments ShiftedSums::moments(double c) const {
+  Moments m;
+  if (n == 0) return m;
+  const double nn = double(n), a = s1 / nn;
+  m.n = n;
+  m.mean = c + a;
+  m.m2 = std::max(0.0, s2 - s1 * a);  // >= 0 in exact arithmetic; rounding must not make it negative
+  return m;
+}
+
+double Reference::mean() const {
+  return kind == Kind::rayleigh ? sigma * std::sqrt(std::numbers::pi / 2) : 0.0;
+}
+
 double Reference::cdf(double x) const {
   if (kind == Kind::rayleigh) return x <= 0 ? 0.0 : -std::expm1(-x * x / (2 * sigma * sigma));
   return 0.5 * std::erfc(-x / (sigma * std::numbers::sqrt2));

@@ -174,7 +174,11 @@ TEST(CliScene, ATinySceneWritesAReportWithItsPlan) {
                                              "[ensemble]\ndrops = 3000\n[outputs]\nplots = false\n"
                                              "report = \"tiny.json\"\ndir = \"" + out.string() + "\"\n");
   const CliRun r = run("--scene " + scene.string());
-  ASSERT_EQ(r.status, 0) << r.out;
+  // This test is about the report and its plan, not the verdict: status 1 (a law rejected) is a
+  // complete run too. Six decisive tests at alpha = 0.01 on 3000 drops reject at least one law in a
+  // few percent of seeds; with the explicit drops' Marsaglia rotations seed 1 is such a seed (r_y,
+  // p = 0.001), and over seeds 1..300 each of the six tests rejected 2-4 times (calibrated).
+  ASSERT_TRUE(r.status == 0 || r.status == 1) << r.out;
   EXPECT_NE(r.out.find("scene tiny"), std::string::npos) << r.out;
   const auto j = read_report(out / "tiny.json");
   EXPECT_EQ(j.at("scene"), "tiny");

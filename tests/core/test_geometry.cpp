@@ -5,10 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
+#include <vector>
 
 #include <Random123/uniform.hpp>
 
+#include "asperity/core/contact.hpp"
 #include "asperity/core/geometry.hpp"
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
@@ -141,6 +144,104 @@ TEST(Orientation, BiasedSamplersAreRejected) {
   EXPECT_LT(std::min(e.p_angle, e.p_down), 1e-6);
   const auto c = check_haar(cube, 100000);
   EXPECT_LT(c.p_angle, 1e-6);
+}
+
+TEST(Orientation, MarsagliaIsHaar) {
+  // The explicit drops' trig-free draw: the same two KS tests as Shoemake's, n = 10^5 rotations,
+  // alpha = 0.001 per test (fixed seed: deterministic). The wrong draws below, at the same n, must
+  // be rejected: uniform Euler angles (above) and this draw with the disk rejection left out
+  // (points uniform in the square, scaled the same way: not uniform on S^3).
+  const auto r = check_haar([](Stream& s) { return random_rotation_marsaglia(s); }, 100000);
+  EXPECT_GT(r.p_angle, 1e-3);
+  EXPECT_GT(r.p_down, 1e-3);
+  auto square = [](Stream& s) {
+    const double x1 = 2 * s.uniform0() - 1, x2 = 2 * s.uniform0() - 1, x3 = 2 * s.uniform0() - 1,
+                 x4 = 2 * s.uniform0() - 1;
+    const double s1 = x1 * x1 + x2 * x2, s2 = x3 * x3 + x4 * x4;
+    const double f = std::sqrt(std::abs(1 - s1) / s2);
+    return Rotation(x1, x2, x3 * f, x4 * f).normalized();
+  };
+  const auto w = check_haar(square, 100000);
+  EXPECT_LT(std::min(w.p_angle, w.p_down), 1e-6);
+  std::printf("Marsaglia n = 1e5: KS p angle %.3g, down %.3g; square-not-disk draw: %.3g, %.3g\n", r.p_angle, r.p_down,
+              w.p_angle, w.p_down);
+}
+
+TEST(Orientation, MarsagliaDropsHaveShoemakesContactLaw) {
+  // Every field an explicit drop produces is a function of the rotation and the sphere, so two
+  // exact Haar draws give one law per field. Checked on one sphere (N = 200: its own quenched law,
+  // the same for both draws): two-sample KS between 10^5 Shoemake and 10^5 Marsaglia drops (other
+  // seeds) of r_x, r_y, r_z, r_xy, the runner-up gap, the body-frame down z and the touching
+  // asperity's index, alpha = 10^-3 each. Uniform Euler angles in place of Marsaglia's draw, same n,
+  // must be rejected (p < 10^-6 in some field).
+  SphereParams sp;
+  sp.asperities = 200;
+  const RoughSphere body = make_rough_sphere(sp, 4, 0);
+  const double R = sp.radius, a = sp.asperity_radius;
+  constexpr std::size_t kN = 100000, kF = 7;
+  auto fields = [&](auto draw, std::uint64_t seed) {
+    std::vector<std::vector<double>> f(kF);
+    for (std::size_t i = 0; i < kN; ++i) {
+      Stream st(seed, Purpose::test, i);
+      const Rotation q = draw(st);
+      const Vec3 d = body_down(q);
+      const Nearest nn = brute_lowest(body.centres, d);
+      const Contact c = make_contact(nn, body.centres[nn.index], q, R, a);
+      const double v[kF] = {c.r.x(), c.r.y(), c.r.z(), c.r_xy, c.gap, d.z(), double(c.index)};
+      for (std::size_t k = 0; k < kF; ++k) f[k].push_back(v[k]);
+    }
+    for (auto& x : f) std::sort(x.begin(), x.end());
+    return f;
+  };
+  auto shoemake = [](Stream& st) { return random_rotation(st); };
+  auto marsaglia = [](Stream& st) { return random_rotation_marsaglia(st); };
+  auto euler = [](Stream& st) {
+    const double x = 2 * std::numbers::pi * st.uniform0(), y = std::numbers::pi * st.uniform0(),
+                 z = 2 * std::numbers::pi * st.uniform0();
+    return Rotation(Eigen::AngleAxisd(x, Vec3::UnitZ()) * Eigen::AngleAxisd(y, Vec3::UnitY()) *
+                    Eigen::AngleAxisd(z, Vec3::UnitZ()));
+  };
+  const auto ref = fields(shoemake, 11), good = fields(marsaglia, 12), bad = fields(euler, 13);
+  double worst_bad = 1;
+  std::printf("Shoemake vs Marsaglia drops, two-sample KS p (r_x r_y r_z r_xy gap down_z index):");
+  for (std::size_t k = 0; k < kF; ++k) {
+    const double p = ks_two_sample(ref[k], good[k]).p;
+    std::printf(" %.3g", p);
+    EXPECT_GT(p, 1e-3) << "field " << k;
+    worst_bad = std::min(worst_bad, ks_two_sample(ref[k], bad[k]).p);
+  }
+  std::printf("; Euler angles, smallest p %.3g\n", worst_bad);
+  EXPECT_LT(worst_bad, 1e-6);
+}
+
+TEST(Orientation, MarsagliaUnitAndCalibrated) {
+  // |q| = 1 within a few ulp (the draw does not normalise; the grid accepts | |d|^2 - 1 | <= 1e-12).
+  // Calibration of the Haar check: 400 independent replicates of n = 500 rotations, each test at
+  // alpha = 0.05; under the true law the rejections are Binomial(400, 0.05): mean 20, sd 4.4.
+  // [8, 34] holds with probability > 0.998 for each of the two tests.
+  for (std::uint64_t i = 0; i < 1000; ++i) {
+    Stream s(7, Purpose::test, i);
+    EXPECT_NEAR(random_rotation_marsaglia(s).squaredNorm(), 1.0, 1e-15);
+  }
+  int ra = 0, rd = 0;
+  for (std::uint64_t rep = 0; rep < 400; ++rep) {
+    std::vector<double> w, z;
+    for (std::uint64_t i = 0; i < 500; ++i) {
+      Stream s(rep + 1, Purpose::test, i);
+      const Rotation q = random_rotation_marsaglia(s);
+      w.push_back(2 * std::acos(std::min(1.0, std::abs(q.w()))));
+      z.push_back(body_down(q).z());
+    }
+    std::sort(w.begin(), w.end());
+    std::sort(z.begin(), z.end());
+    ra += ks_one_sample(w, [](double t) { return std::clamp((t - std::sin(t)) / std::numbers::pi, 0.0, 1.0); }).p < 0.05;
+    rd += ks_one_sample(z, [](double t) { return std::clamp((t + 1) / 2, 0.0, 1.0); }).p < 0.05;
+  }
+  std::printf("Marsaglia calibration: 400 x n = 500, alpha 0.05: angle rejected %d, down rejected %d\n", ra, rd);
+  EXPECT_GE(ra, 8);
+  EXPECT_LE(ra, 34);
+  EXPECT_GE(rd, 8);
+  EXPECT_LE(rd, 34);
 }
 
 }  // namespace

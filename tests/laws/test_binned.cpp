@@ -87,6 +87,31 @@ TEST(Binned, ChunkedMergeInIndexOrderIsBitIdenticalForAnyThreadCount) {
   EXPECT_NEAR(one.moments().mean, std::sqrt(M_PI / 2), 5 * std::sqrt((4 - M_PI) / 2 / double(n)));
 }
 
+TEST(Binned, ShiftedSumsAreWelfordsMoments) {
+  // The streaming run's per-unit sums about the reference mean give Welford's moments to rounding,
+  // for a shift anywhere within a few sd of the mean (Rayleigh(3e-6) samples, like r_xy in metres),
+  // and the same bits for the same sequence.
+  const double sigma = 3e-6, c = kRef.mean() * sigma;
+  for (const double shift : {c, 0.0, c + 3 * sigma}) {
+    Moments w;
+    ShiftedSums a, b;
+    for (std::uint64_t i = 0; i < 4096; ++i) {
+      Stream st(3, Purpose::test, i);
+      const double x = sigma * std::sqrt(-2 * std::log(st.uniform()));
+      w.add(x);
+      a.add(x, shift);
+      b.add(x, shift);
+    }
+    const Moments m = a.moments(shift);
+    EXPECT_EQ(m.n, w.n);
+    EXPECT_NEAR(m.mean, w.mean, 1e-14 * sigma);
+    EXPECT_NEAR(m.variance(), w.variance(), 1e-11 * w.variance());
+    EXPECT_TRUE(m == b.moments(shift));
+  }
+  EXPECT_EQ(ShiftedSums{}.moments(1.0).n, 0u);
+  EXPECT_EQ((Reference{Reference::Kind::normal, 2.0}.mean()), 0.0);
+}
+
 TEST(Binned, MergeRefusesDifferentLayouts) {
   BinnedStats a = make_binned(kRef, 4), b = make_binned(kRef, 8);
   EXPECT_THROW(a.merge(b), std::invalid_argument);

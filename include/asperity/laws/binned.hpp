@@ -42,12 +42,31 @@ struct Moments {
   friend bool operator==(const Moments&, const Moments&) = default;
 };
 
+/// Sums of d = x - c and d^2 about a fixed shift c: no division per sample (Welford's add has
+/// one, in a dependency chain), for the per-drop loop. moments(c) turns them into a Moments
+/// (mean c + S1/n, m2 = S2 - S1^2/n), merged with Chan's formula as before. Accurate when c is
+/// within a few standard deviations of the mean: the cancellation in S2 - S1^2/n costs
+/// log10(1 + (mean - c)^2 / var) digits (the streaming run uses the reference law's mean).
+/// Deterministic like Moments.
+struct ShiftedSums {
+  std::uint64_t n = 0;
+  double s1 = 0, s2 = 0;
+  void add(double x, double c) {
+    const double d = x - c;
+    ++n;
+    s1 += d;
+    s2 += d * d;
+  }
+  Moments moments(double c) const;
+};
+
 /// The reference law whose cdf makes the bins equiprobable: closed-form cdf and quantile.
 struct Reference {
   enum class Kind { rayleigh, normal } kind = Kind::rayleigh;
   double sigma = 1;  ///< Rayleigh scale (cdf 1 - exp(-x^2 / 2 sigma^2)) or normal standard deviation
   double cdf(double x) const;
   double quantile(double u) const;  ///< u in [0, 1]; quantile(0) and quantile(1) are the support's ends
+  double mean() const;              ///< sigma sqrt(pi / 2) (Rayleigh) or 0 (normal)
   std::string name() const;         ///< e.g. "Rayleigh(sigma = 3.2e-06)"
   friend bool operator==(const Reference&, const Reference&) = default;
 };

@@ -90,6 +90,7 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 constexpr int kRowSlots = 8;
 constexpr double kPerCell = 1.3;
 constexpr std::size_t kPad = kRowSlots + 4;  // readable slots past the last point
+constexpr std::size_t kResidentBytes = std::size_t{1} << 20;  // batched queries without prefetch up to this
 
 /// Allocator for the big arrays: 2 MiB-aligned and, on Linux, backed by transparent huge pages
 /// when available, so that the random accesses of the queries do not miss the TLB each time.
@@ -289,6 +290,12 @@ class Grid final : public ContactQuery {
 
   void lowest(std::span<const Vec3> d, std::span<Nearest> out) const override {
     if (out.size() != d.size()) throw std::invalid_argument("lowest(): output size differs from input size");
+    // An index that fits in a core's L2 is answered query by query: the pipeline's prefetches
+    // then only cost instructions (N = 10^4: -8% CPU per drop; at N = 3x10^4, 1.6 MB, they pay).
+    if (memory_bytes() <= kResidentBytes) {
+      for (std::size_t q = 0; q < d.size(); ++q) out[q] = lowest(d[q]);
+      return;
+    }
     // Software pipeline: query q is located (and its cell starts prefetched) at step q, its points
     // are prefetched at step q + kLag, and it is searched at step q + 2 kLag.
     constexpr std::size_t kLag = 8, kRing = 32;  // >= 2 kLag + 1; a power of two: % is a mask
@@ -391,10 +398,12 @@ class Grid final : public ContactQuery {
       const Vec3& p = c_[static_cast<std::size_t>(i)];
       for (int a = 0; a < 3; ++a) cell[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(a)] = cell_id(p, a);
     }
-    // Pass 2: counting sort by cell, stable, so each cell lists its points in index order.
+    // Pass 2: counting sort by cell, stable, so each cell lists its points in index order. About
+    // half the candidate faces hold the point: branch-free, kNone + 1 wraps to 0 (cleared after).
     cs_.assign(ncell + 1, 0);
-    for (std::uint32_t v : cell)
-      if (v != kNone) ++cs_[v + 1];
+    std::uint32_t* cs = cs_.data();
+    for (std::uint32_t v : cell) ++cs[static_cast<std::uint32_t>(v + 1)];
+    cs_[0] = 0;
     std::uint64_t total = 0;
     for (std::size_t k = 1; k <= ncell; ++k) {
       total += cs_[k];
@@ -403,16 +412,21 @@ class Grid final : public ContactQuery {
     }
     // kPad readable slots past the end: the fast path reads whole runs of kRowSlots.
     pts_.assign(total + kPad, Pt{0.0, 0.0, 0.0, kNone, 0});
-    std::vector<std::uint32_t> fill(cs_.begin(), cs_.end() - 1);
+    // Branch-free too: a face that does not hold the point writes to the first pad slot (fill's
+    // extra entry, never advanced), which is reset afterwards.
+    std::vector<std::uint32_t> fill(cs_.begin(), cs_.end());
+    Pt* pts = pts_.data();
+    const auto dummy = static_cast<std::uint32_t>(ncell);
     for (std::size_t i = 0; i < n; ++i) {
       const Vec3& p = c_[i];
       for (std::size_t a = 0; a < 3; ++a) {
-        const std::uint32_t v = cell[3 * i + a];
-        if (v == kNone) continue;
-        const std::uint32_t k = fill[v]++;
-        pts_[k] = Pt{p.x(), p.y(), p.z(), static_cast<std::uint32_t>(i), 0};
+        const std::uint32_t v = cell[3 * i + a], slot = v == kNone ? dummy : v;
+        const std::uint32_t k = fill[slot];
+        fill[slot] = k + (v == kNone ? 0u : 1u);
+        pts[k] = Pt{p.x(), p.y(), p.z(), static_cast<std::uint32_t>(i), 0};
       }
     }
+    pts_[total] = Pt{0.0, 0.0, 0.0, kNone, 0};
   }
 
   // ---- query ----------------------------------------------------------------------------------
