@@ -459,30 +459,46 @@ std::size_t bootstrap_count(const BounceExperiment& b, std::size_t n) {
                           : std::min<std::size_t>(std::max(b.bootstrap, B_floor), std::max<std::size_t>(19, 20000000 / n));
 }
 
-// Eq. 2 fitted to the (sorted) group and its parametric-bootstrap KS test.
-void laplace_test(const BounceExperiment& b, std::uint64_t seed, std::uint64_t index, BounceGroup& g) {
+// Eq. 2 fitted to the (sorted) group; its bootstrap test comes later (gof_jobs, bootstrap_verdict).
+void laplace_fit(BounceGroup& g) {
   if (g.n < 20) return;
   try {
     g.fit = fit_asymmetric_laplace_sorted(g.sorted);
     g.fitted = true;
-    // B adapts up to the smallest count whose floor 1/(1+B) is below alpha (ceil(1/alpha): 100 at
-    // alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
-    // for the big low-speed windows; a group left with floor >= alpha is undecided when no
-    // replicate reaches D (below), never accepted.
-    const std::size_t B = bootstrap_count(b, g.n);
-    if (b.bootstrap > 0) {
-      g.gof = laplace_gof(g.sorted, g.fit, B, seed, index, SequentialStop{b.bootstrap_stop, b.alpha});
-      // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
-      // when floor > alpha that is no verdict (the group can never reject at this B).
-      const double floor = 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap));
-      g.gof_verdict = verdict_at(g.gof.p, b.alpha);
-      if (g.gof_verdict == Verdict::accept && g.gof.p <= floor * (1 + 1e-9) && !(floor < b.alpha))
-        g.gof_verdict = Verdict::undecided;
-    } else {
-      g.gof.p = kNaN, g.gof.D = 0;
-    }
   } catch (const std::invalid_argument&) {
     g.fitted = false;  // e.g. all values equal
+  }
+}
+
+// The bootstrap test of every fitted group, all replicates in one parallel loop (laplace_gof_batch).
+// B adapts up to the smallest count whose floor 1/(1+B) is below alpha (ceil(1/alpha): 100 at
+// alpha = 0.01; B = 99 could never reject), within a work budget B n <= 2e7 draws (B >= 19)
+// for the big low-speed windows; a group left with floor >= alpha is undecided when no
+// replicate reaches D (bootstrap_verdict), never accepted.
+void bootstrap_tests(const BounceExperiment& b, std::uint64_t seed, const std::vector<std::uint64_t>& index,
+                     std::vector<BounceGroup>& groups) {
+  std::vector<GofJob> jobs;
+  std::vector<std::size_t> of;  // the group of each job
+  for (std::size_t j = 0; j < groups.size(); ++j) {
+    auto& g = groups[j];
+    if (!g.fitted) continue;
+    if (b.bootstrap == 0) {
+      g.gof.p = kNaN, g.gof.D = 0;
+      continue;
+    }
+    jobs.push_back({g.sorted, &g.fit, bootstrap_count(b, g.n), index[j], SequentialStop{b.bootstrap_stop, b.alpha}});
+    of.push_back(j);
+  }
+  const auto gof = laplace_gof_batch(jobs, seed);
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    auto& g = groups[of[i]];
+    g.gof = gof[i];
+    // p = (1 + #{D_b >= D})/(1 + B): with no replicate at D the test only says p <= floor;
+    // when floor > alpha that is no verdict (the group can never reject at this B).
+    const double floor = 1.0 / (1.0 + static_cast<double>(g.gof.bootstrap));
+    g.gof_verdict = verdict_at(g.gof.p, b.alpha);
+    if (g.gof_verdict == Verdict::accept && g.gof.p <= floor * (1 + 1e-9) && !(floor < b.alpha))
+      g.gof_verdict = Verdict::undecided;
   }
 }
 
@@ -494,7 +510,7 @@ struct GroupSpec {
 };
 
 BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const std::vector<BounceResidualLaw>& laws,
-                       const Restitution& en, const GroupSpec& spec, std::uint64_t seed) {
+                       const Restitution& en, const GroupSpec& spec) {
   BounceGroup g;
   g.by = spec.window ? "speed" : "impact", g.lo = spec.lo, g.hi = spec.hi;
   g.quantity = spec.window ? "eps-eps_n(u)" : "eps";
@@ -507,41 +523,44 @@ BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const 
   // A window's quantity is its residual, already sorted above: the same values, one sort fewer.
   if (spec.window && std::is_sorted(t.res.begin(), t.res.end())) g.sorted = std::move(t.res);
   else std::sort(g.sorted.begin(), g.sorted.end());
-  laplace_test(b, seed, spec.index, g);
+  laplace_fit(g);
   return g;
 }
 
 // The groups side by side, one thread each (each group is a pure function of the samples and its
-// own streams, so the report is the same for any thread count). With fewer groups than twice the
-// threads they run one after the other and each bootstrap uses every thread instead.
+// own streams, so the report is the same for any thread count), then the bootstrap tests of all
+// groups together, their replicates spread over the threads.
 std::vector<BounceGroup> make_groups(const BounceSamples& s, const BounceExperiment& b,
                                      const std::vector<BounceResidualLaw>& laws, const Restitution& en,
                                      const std::vector<GroupSpec>& specs, std::uint64_t seed) {
   std::vector<BounceGroup> groups(specs.size());
   std::vector<std::exception_ptr> errors(specs.size());
   const auto m = static_cast<std::int64_t>(specs.size());
-  // Largest bootstrap work (n B) first, so that no big group starts last and runs alone.
+  // Largest groups (their sorts) first, so that no big group starts last and runs alone.
   std::vector<std::size_t> n(specs.size(), 0), order(specs.size());
-  for (std::size_t j = 0; j < s.eps.size(); ++j)
-    for (std::size_t g = 0; g < specs.size(); ++g)
-      n[g] += specs[g].window ? (s.speed[j] >= specs[g].lo && s.speed[j] <= specs[g].hi) : s.number[j] == specs[g].lo;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t g = 0; g < m; ++g) {
+    const auto& sp = specs[static_cast<std::size_t>(g)];
+    std::size_t c = 0;
+    for (std::size_t j = 0; j < s.eps.size(); ++j) c += sp.window ? (s.speed[j] >= sp.lo && s.speed[j] <= sp.hi) : s.number[j] == sp.lo;
+    n[static_cast<std::size_t>(g)] = c;
+  }
   for (std::size_t g = 0; g < order.size(); ++g) order[g] = g;
-  auto work = [&](std::size_t g) {
-    const std::size_t B = n[g] ? bootstrap_count(b, n[g]) : 0;
-    return static_cast<double>(n[g]) * static_cast<double>(std::max<std::size_t>(1, B));
-  };
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return work(x) > work(y); });
-#pragma omp parallel for schedule(dynamic, 1) if (m >= 2 * omp_get_max_threads())
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return n[x] > n[y]; });
+#pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t i = 0; i < m; ++i) {
     const auto j = order[static_cast<std::size_t>(i)];
     try {
-      groups[j] = make_group(s, b, laws, en, specs[j], seed);
+      groups[j] = make_group(s, b, laws, en, specs[j]);
     } catch (...) {
       errors[j] = std::current_exception();  // an exception must not leave the parallel region
     }
   }
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);
+  std::vector<std::uint64_t> index;
+  for (const auto& sp : specs) index.push_back(sp.index);
+  bootstrap_tests(b, seed, index, groups);
   return groups;
 }
 

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
+#include <utility>
 #include <stdexcept>
 #include <string>
 
@@ -218,41 +220,90 @@ bool replicate_exceeds(const LaplaceFit& fit, double pl, double D, std::size_t n
 }
 }  // namespace
 
+namespace {
+// A job's replicates as they finish, folded into K and L in replicate order.
+struct JobState {
+  std::mutex m;
+  std::vector<std::int8_t> exceed;  // per replicate: -1 not known yet, else 0 / 1
+  std::size_t next = 0, k = 0;      // replicates [0, next) folded in, k of them >= D
+  bool stopped = false;             // the stop rule held after replicate next - 1
+};
+
+bool stop_holds(const SequentialStop& stop, std::size_t k, std::size_t done, std::size_t B) {
+  const double kd = static_cast<double>(k);
+  return stop.exceedances > 0 && k >= stop.exceedances && kd / static_cast<double>(done) >= stop.alpha &&
+         (kd + 1.0) / (static_cast<double>(B) + 1.0) >= stop.alpha;
+}
+
+// Records replicate b and folds in every replicate now known in order, as a sequential loop
+// would: the stop happens at the same replicate whatever order the threads finish in.
+void record(JobState& st, const GofJob& job, std::size_t b, bool exceeds) {
+  std::lock_guard<std::mutex> lock(st.m);
+  st.exceed[b] = exceeds ? 1 : 0;
+  while (!st.stopped && st.next < job.bootstrap && st.exceed[st.next] >= 0) {
+    st.k += static_cast<std::size_t>(st.exceed[st.next++]);
+    st.stopped = stop_holds(job.stop, st.k, st.next, job.bootstrap);
+  }
+}
+
+bool finished(JobState& st) {
+  std::lock_guard<std::mutex> lock(st.m);
+  return st.stopped;
+}
+
+LaplaceGof result_of(const GofJob& job, const JobState& st, double D) {
+  LaplaceGof g;
+  g.D = D;
+  g.bootstrap = job.bootstrap;
+  g.replicates = st.next, g.exceedances = st.k;
+  g.stopped_early = st.stopped && st.next < job.bootstrap;
+  g.p = g.stopped_early ? static_cast<double>(st.k) / static_cast<double>(st.next)
+                        : (1.0 + static_cast<double>(st.k)) / (1.0 + static_cast<double>(job.bootstrap));
+  return g;
+}
+}  // namespace
+
+std::vector<LaplaceGof> laplace_gof_batch(std::span<const GofJob> jobs, std::uint64_t seed) {
+  const std::size_t nj = jobs.size();
+  std::vector<double> D(nj), pl(nj);
+  std::vector<JobState> state(nj);
+  std::vector<std::size_t> order(nj);
+#pragma omp parallel for schedule(dynamic, 1) if (nj > 1)
+  for (std::int64_t jj = 0; jj < static_cast<std::int64_t>(nj); ++jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    D[j] = ks_distance(jobs[j].sorted, jobs[j].fit->law);
+    const auto& law = jobs[j].fit->law;
+    pl[j] = law.c() / (law.a() + law.c());  // P(t < m) of the generating law
+    state[j].exceed.assign(jobs[j].bootstrap, -1);
+    order[j] = j;
+  }
+  // Largest work first: the big tests' replicates are shared by all threads from the start.
+  auto work = [&](std::size_t j) { return static_cast<double>(jobs[j].sorted.size()) * static_cast<double>(jobs[j].bootstrap); };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return work(x) > work(y); });
+  std::vector<std::pair<std::size_t, std::size_t>> items;  // (job, replicate) in that order
+  for (std::size_t j : order)
+    for (std::size_t b = 0; b < jobs[j].bootstrap; ++b) items.emplace_back(j, b);
+  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
+  std::vector<ReplicateScratch> scratch(static_cast<std::size_t>(threads));
+  const auto m = static_cast<std::int64_t>(items.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (m > 1)
+  for (std::int64_t i = 0; i < m; ++i) {
+    const auto [j, b] = items[static_cast<std::size_t>(i)];
+    if (finished(state[j])) continue;  // past the stop: would be discarded
+    const bool e = replicate_exceeds(*jobs[j].fit, pl[j], D[j], jobs[j].sorted.size(), seed, jobs[j].stream_index, b,
+                                     scratch[static_cast<std::size_t>(omp_get_thread_num())]);
+    record(state[j], jobs[j], b, e);
+  }
+  std::vector<LaplaceGof> out;
+  out.reserve(nj);
+  for (std::size_t j = 0; j < nj; ++j) out.push_back(result_of(jobs[j], state[j], D[j]));
+  return out;
+}
+
 LaplaceGof laplace_gof(std::span<const double> sorted, const LaplaceFit& fit, std::size_t bootstrap, std::uint64_t seed,
                        std::uint64_t stream_index, SequentialStop stop) {
-  LaplaceGof g;
-  g.D = ks_distance(sorted, fit.law);
-  g.bootstrap = bootstrap;
-  const std::size_t n = sorted.size(), B = bootstrap;
-  const double pl = fit.law.c() / (fit.law.a() + fit.law.c());  // P(t < m) of the generating law
-  // Without a stop all B replicates form one parallel batch; with one, batches of one replicate
-  // per thread are decided in replicate order (the replicates past the stop are discarded).
-  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
-  const std::size_t batch = stop.exceedances == 0 ? std::max<std::size_t>(B, 1) : static_cast<std::size_t>(threads);
-  std::vector<ReplicateScratch> scratch(static_cast<std::size_t>(threads));
-  std::vector<std::uint8_t> exceed(B, 0);
-  std::size_t k = 0, done = 0;
-  for (std::size_t b0 = 0; b0 < B && !g.stopped_early; b0 += batch) {
-    const auto b1 = static_cast<std::int64_t>(std::min(B, b0 + batch));
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (b1 - static_cast<std::int64_t>(b0) > 1)
-    for (std::int64_t b = static_cast<std::int64_t>(b0); b < b1; ++b)
-      exceed[static_cast<std::size_t>(b)] =
-          replicate_exceeds(fit, pl, g.D, n, seed, stream_index, static_cast<std::size_t>(b),
-                            scratch[static_cast<std::size_t>(omp_get_thread_num())]) ? 1 : 0;
-    for (std::size_t b = b0; b < static_cast<std::size_t>(b1); ++b) {
-      k += exceed[b], done = b + 1;
-      const double kd = static_cast<double>(k);
-      if (stop.exceedances > 0 && k >= stop.exceedances && kd / static_cast<double>(done) >= stop.alpha &&
-          (kd + 1.0) / (static_cast<double>(B) + 1.0) >= stop.alpha) {
-        g.stopped_early = done < B;
-        break;
-      }
-    }
-  }
-  g.replicates = done, g.exceedances = k;
-  g.p = g.stopped_early ? static_cast<double>(k) / static_cast<double>(done)
-                        : (1.0 + static_cast<double>(k)) / (1.0 + static_cast<double>(bootstrap));
-  return g;
+  const GofJob job{sorted, &fit, bootstrap, stream_index, stop};
+  return laplace_gof_batch(std::span<const GofJob>(&job, 1), seed).front();
 }
 
 }  // namespace asperity
