@@ -244,6 +244,20 @@ Flight ballistic_flight(double h0, double vz, double D, double g) {
   return {(vz + root) / g, -root};
 }
 
+namespace {
+// Room for all impacts, extrapolated from the first block (+5 %): the append after each block is
+// serial, and growing 8 vectors of ~5e6 entries by doubling copies them and faults in their pages
+// twice over. Only capacity: a wrong estimate just lets them grow as before.
+void reserve_samples(BounceSamples& s, const std::vector<SequenceOut>& outs, std::size_t m, std::uint64_t sequences) {
+  std::size_t impacts = 0;
+  for (std::size_t j = 0; j < m; ++j) impacts += outs[j].impacts.size();
+  const auto n = static_cast<std::size_t>(1.05 * static_cast<double>(impacts) * static_cast<double>(sequences) /
+                                          static_cast<double>(std::max<std::size_t>(1, m))) + 1;
+  s.sequence.reserve(n), s.number.reserve(n), s.speed.reserve(n), s.eps.reserve(n);
+  s.eps_time.reserve(n), s.spin.reserve(n), s.omega_x_after.reserve(n), s.core.reserve(n);
+}
+}  // namespace
+
 BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b, BounceVariant v, std::uint64_t seed,
                           int threads, const Progress& progress) {
   validate(sphere);
@@ -293,6 +307,7 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
       }
     }
     // Append in sequence order: identical for any thread count and schedule.
+    if (start == 0) reserve_samples(s, outs, static_cast<std::size_t>(m), b.sequences);
     for (std::int64_t j = 0; j < m; ++j) {
       const auto& o = outs[static_cast<std::size_t>(j)];
       const auto i = static_cast<std::uint32_t>(start + static_cast<std::uint64_t>(j));
@@ -313,6 +328,25 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// eps_n(u) of Eq. 9 at every impact's speed, once (the lag-1 correlation and every group use it).
+std::vector<double> eps_n_of_impacts(const BounceSamples& s, double beta) {
+  const auto en = viscoelastic_pade14(beta);
+  std::vector<double> e(s.speed.size());
+  std::exception_ptr error;
+  const auto n = static_cast<std::int64_t>(e.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t j = 0; j < n; ++j) {
+    try {
+      e[static_cast<std::size_t>(j)] = (*en)(s.speed[static_cast<std::size_t>(j)]);
+    } catch (...) {
+#pragma omp critical(bounce_eps_n)
+      if (!error) error = std::current_exception();  // must not leave the parallel region
+    }
+  }
+  if (error) std::rethrow_exception(error);
+  return e;
+}
 
 // Per sequence: the spin before its last impact; per impact: eps(times) - eps(velocities).
 void summarise_sequences(const BounceSamples& s, BounceVariantReport& r) {
@@ -335,13 +369,12 @@ void summarise_sequences(const BounceSamples& s, BounceVariantReport& r) {
 
 // Correlation of consecutive residuals eps - eps_n(u) of one sequence (both impacts after the
 // first spin-up, k - 1 >= 2): the memory the paper's procedure keeps and explicit geometry does not.
-void lag1_residual_correlation(const BounceSamples& s, double beta, BounceVariantReport& r) {
-  const auto en0 = viscoelastic_pade14(beta);
+void lag1_residual_correlation(const BounceSamples& s, const std::vector<double>& en_u, BounceVariantReport& r) {
   double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
   std::size_t np = 0;
   for (std::size_t j = 1; j < s.eps.size(); ++j) {
     if (s.sequence[j] != s.sequence[j - 1] || s.number[j - 1] < 2) continue;
-    const double x = s.eps[j - 1] - (*en0)(s.speed[j - 1]), y = s.eps[j] - (*en0)(s.speed[j]);
+    const double x = s.eps[j - 1] - en_u[j - 1], y = s.eps[j] - en_u[j];
     sx += x, sy += y, sxx += x * x, syy += y * y, sxy += x * y, ++np;
   }
   r.lag1_pairs = np;
@@ -375,13 +408,14 @@ struct GroupSums {
 };
 
 template <class Member>
-GroupSums collect_group(const BounceSamples& s, const BounceExperiment& b, const Restitution& en, std::size_t laws,
-                        bool window, const Member& member, BounceGroup& g) {
+GroupSums collect_group(const BounceSamples& s, const BounceExperiment& b, const std::vector<double>& en_u,
+                        std::size_t laws, std::size_t n, bool window, const Member& member, BounceGroup& g) {
   GroupSums t;
+  t.res.reserve(n), g.sorted.reserve(n);
   t.kcount.assign(laws + 1, 0);
   for (std::size_t j = 0; j < s.eps.size(); ++j) {
     if (!member(j)) continue;
-    const double r = s.eps[j] - en(s.speed[j]);
+    const double r = s.eps[j] - en_u[j];
     t.res.push_back(r);
     g.sorted.push_back(window ? r : s.eps[j]);
     if (s.number[j] <= laws) ++t.kcount[s.number[j]];
@@ -513,14 +547,14 @@ struct GroupSpec {
 };
 
 BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const std::vector<BounceResidualLaw>& laws,
-                       const Restitution& en, const GroupSpec& spec) {
+                       const std::vector<double>& en_u, const GroupSpec& spec, std::size_t n) {
   BounceGroup g;
   g.by = spec.window ? "speed" : "impact", g.lo = spec.lo, g.hi = spec.hi;
   g.quantity = spec.window ? "eps-eps_n(u)" : "eps";
   const auto k = static_cast<std::uint32_t>(spec.lo);
-  GroupSums t = spec.window ? collect_group(s, b, en, laws.size(), true,
+  GroupSums t = spec.window ? collect_group(s, b, en_u, laws.size(), n, true,
                                             [&](std::size_t j) { return s.speed[j] >= spec.lo && s.speed[j] <= spec.hi; }, g)
-                            : collect_group(s, b, en, laws.size(), false, [&](std::size_t j) { return s.number[j] == k; }, g);
+                            : collect_group(s, b, en_u, laws.size(), n, false, [&](std::size_t j) { return s.number[j] == k; }, g);
   residual_statistics(t, laws, g);  // sorts t.res (n > 2)
   group_moments(t, g);
   // A window's quantity is its residual, already sorted above: the same values, one sort fewer.
@@ -534,7 +568,7 @@ BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const 
 // own streams, so the report is the same for any thread count), then the bootstrap tests of all
 // groups together, their replicates spread over the threads.
 std::vector<BounceGroup> make_groups(const BounceSamples& s, const BounceExperiment& b,
-                                     const std::vector<BounceResidualLaw>& laws, const Restitution& en,
+                                     const std::vector<BounceResidualLaw>& laws, const std::vector<double>& en_u,
                                      const std::vector<GroupSpec>& specs, std::uint64_t seed) {
   std::vector<BounceGroup> groups(specs.size());
   std::vector<std::exception_ptr> errors(specs.size());
@@ -554,7 +588,7 @@ std::vector<BounceGroup> make_groups(const BounceSamples& s, const BounceExperim
   for (std::int64_t i = 0; i < m; ++i) {
     const auto j = order[static_cast<std::size_t>(i)];
     try {
-      groups[j] = make_group(s, b, laws, en, specs[j]);
+      groups[j] = make_group(s, b, laws, en_u, specs[j], n[j]);
     } catch (...) {
       errors[j] = std::current_exception();  // an exception must not leave the parallel region
     }
@@ -578,14 +612,14 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
   r.cells_per_sequence = static_cast<double>(s.cells) / ns;
   r.centres_per_sequence = static_cast<double>(s.centres) / ns;
   summarise_sequences(s, r);
-  lag1_residual_correlation(s, b.beta, r);
-  const auto en = viscoelastic_pade14(b.beta);
+  const std::vector<double> en_u = eps_n_of_impacts(s, b.beta);
+  lag1_residual_correlation(s, en_u, r);
   const std::vector<BounceResidualLaw> laws = residual_laws(s, b);
   const std::uint64_t base = 1000000 + 1000 * static_cast<std::uint64_t>(s.variant);
   std::vector<GroupSpec> specs;
   for (const auto& [lo, hi] : b.windows) specs.push_back({true, lo, hi, base + specs.size()});
   for (unsigned k : b.impact_numbers) specs.push_back({false, double(k), double(k), base + specs.size()});
-  r.groups = make_groups(s, b, laws, *en, specs, seed);
+  r.groups = make_groups(s, b, laws, en_u, specs, seed);
   return r;
 }
 
