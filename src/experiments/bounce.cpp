@@ -7,9 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
-#include <future>
-#include <optional>
-#include <utility>
 #include <ostream>
 #include <limits>
 #include <locale>
@@ -623,57 +620,22 @@ BounceVariantReport analyse_bounces(const BounceSamples& s, const BounceExperime
   return r;
 }
 
-namespace {
-// A variant's analysis running on its own thread beside the next variant's sequences.
-struct PendingAnalysis {
-  BounceVariant variant;
-  std::uint64_t sequences = 0, impacts = 0;
-  double run_seconds = 0;
-  std::future<std::pair<BounceVariantReport, double>> report;  // and the analysis' wall seconds
-};
-
-PendingAnalysis start_analysis(BounceSamples&& s, const BounceExperiment& b, std::uint64_t seed, int threads) {
-  PendingAnalysis p{s.variant, s.sequences, s.eps.size(), s.seconds, {}};
-  // A new thread starts with the default OpenMP thread count, not the caller's: pass it on.
-  p.report = std::async(std::launch::async, [&b, seed, threads, s = std::move(s)] {
-    omp_set_num_threads(threads);
-    const auto t0 = Clock::now();
-    BounceVariantReport r = analyse_bounces(s, b, seed);
-    return std::pair{std::move(r), std::chrono::duration<double>(Clock::now() - t0).count()};
-  });
-  return p;
-}
-
-void finish_analysis(PendingAnalysis& p, std::vector<BounceVariantReport>& out, std::ostream* log) {
-  auto [r, seconds] = p.report.get();  // rethrows the analysis' exception
-  out.push_back(std::move(r));
-  if (log)
-    *log << "bounce " << to_string(p.variant) << ": " << p.sequences << " sequences, " << p.impacts << " impacts, run "
-         << p.run_seconds << " s, analysis " << seconds << " s\n";
-}
-}  // namespace
-
 std::vector<BounceVariantReport> run_bounce_experiment(const SphereParams& sphere, const BounceExperiment& b,
                                                        std::uint64_t seed, int threads, std::ostream* log,
                                                        const Progress& progress) {
-  // Each variant's analysis (a pure function of its samples, seeds and streams: the same report for
-  // any thread count) runs beside the next variant's sequences, so the cores the analysis leaves
-  // idle (serial scans, the last bootstrap replicates) do the next run's work. An exception from a
-  // run (e.g. a stop from the progress callback) waits for the analysis in flight (the future's
-  // destructor), a few seconds at most.
   std::vector<BounceVariantReport> out;
   const std::uint64_t total = b.sequences * b.variants.size();
-  const int nt = threads > 0 ? threads : omp_get_max_threads();
-  std::optional<PendingAnalysis> pending;
-  for (std::size_t iv = 0; iv < b.variants.size(); ++iv) {
-    const std::uint64_t offset = b.sequences * iv;
+  for (auto v : b.variants) {
+    const auto t0 = Clock::now();
+    const std::uint64_t offset = b.sequences * out.size();
     Progress in_variant;
     if (progress) in_variant = [&](std::uint64_t done, std::uint64_t) { progress(offset + done, total); };
-    BounceSamples s = run_bounces(sphere, b, b.variants[iv], seed, threads, in_variant);
-    if (pending) finish_analysis(*pending, out, log);
-    pending = start_analysis(std::move(s), b, seed, nt);
+    const BounceSamples s = run_bounces(sphere, b, v, seed, threads, in_variant);
+    out.push_back(analyse_bounces(s, b, seed));
+    if (log)
+      *log << "bounce " << to_string(v) << ": " << s.sequences << " sequences, " << s.eps.size() << " impacts, run "
+           << s.seconds << " s, analysis " << std::chrono::duration<double>(Clock::now() - t0).count() - s.seconds << " s\n";
   }
-  if (pending) finish_analysis(*pending, out, log);
   return out;
 }
 
