@@ -146,7 +146,7 @@ namespace {
 // uniform order statistics are U_(i) = S_i/S_(n+1), S the partial sums of n + 1 standard exponentials
 // (Renyi), mapped through the quantile. Both tails are computed from their own side (S_i for the
 // lower, S_(n+1) - S_i as suffix sums for the upper), so no 1 - U cancels. `tail` is scratch (n + 1).
-void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::vector<double>& y, std::vector<double>& tail) {
+void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::span<double> y, std::span<double> tail) {
   const std::size_t n = y.size();
   for (auto& e : y) e = -std::log(s.uniform());  // E_1 .. E_n (held in y until overwritten)
   const double last = -std::log(s.uniform());    // E_(n+1)
@@ -157,8 +157,9 @@ void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::vector<double>& y
   double lower = 0;
   for (std::size_t i = 0; i < n; ++i) {
     lower += y[i];  // S_(i+1)
-    const double p = lower / total, q = tail[i + 1] / total;
-    y[i] = p < pl ? L.m + std::log(p / pl) / a : L.m - std::log(q / (1.0 - pl)) / c;
+    const double p = lower / total;
+    if (p < pl) y[i] = L.m + std::log(p / pl) / a;
+    else y[i] = L.m - std::log(tail[i + 1] / total / (1.0 - pl)) / c;  // q = tail / total only here
   }
   // Rounding in the two sums can break monotonicity by an ulp near the mode: restore it.
   for (std::size_t i = 1; i < n; ++i) y[i] = std::max(y[i], y[i - 1]);
@@ -173,10 +174,10 @@ namespace {
 // so on [j0, j1] every g_j >= sqrt(L_j0) + sqrt(R_j1); a block whose bound exceeds the best g so
 // far (started at the generating law's mode, where the minimum lies) is skipped. False when all
 // values are equal (no minimum).
-bool replicate_law(std::span<const double> t, double pl, std::vector<double>& R, std::vector<double>& L,
+bool replicate_law(std::span<const double> t, double pl, std::span<double> R, std::span<double> L,
                    AsymmetricLaplace& law) {
   const std::size_t n = t.size();
-  R.assign(n, 0.0), L.assign(n, 0.0);
+  R[n - 1] = 0, L[0] = 0;  // every other entry is written below
   for (std::size_t j = n - 1; j > 0; --j) R[j - 1] = R[j] + static_cast<double>(n - j) * (t[j] - t[j - 1]);
   for (std::size_t j = 1; j < n; ++j) L[j] = L[j - 1] + static_cast<double>(j) * (t[j] - t[j - 1]);
   double best = std::numeric_limits<double>::infinity();
@@ -205,18 +206,25 @@ bool replicate_law(std::span<const double> t, double pl, std::vector<double>& R,
 }  // namespace
 
 namespace {
+// Only grows: a thread moves between tests of different n, and regrowing a vector would zero it
+// (the replicate writes every entry it reads).
 struct ReplicateScratch {
   std::vector<double> y, tail, R, L;
+  void fit(std::size_t n) {
+    if (y.size() < n) y.resize(n), tail.resize(n + 1), R.resize(n), L.resize(n);
+  }
 };
 
 // Whether replicate b of the bootstrap reaches the data's distance D.
 bool replicate_exceeds(const LaplaceFit& fit, double pl, double D, std::size_t n, std::uint64_t seed,
                        std::uint64_t stream_index, std::size_t b, ReplicateScratch& w) {
-  w.y.resize(n), w.tail.resize(n + 1);
+  w.fit(n);
+  const std::span<double> y(w.y.data(), n);
   Stream s(seed, Purpose::analysis, stream_index, static_cast<std::uint64_t>(b) + 1);
-  sorted_sample(fit.law, s, w.y, w.tail);
+  sorted_sample(fit.law, s, y, std::span<double>(w.tail.data(), n + 1));
   AsymmetricLaplace law;
-  return replicate_law(w.y, pl, w.R, w.L, law) && ks_distance_reaches(w.y, law, D);
+  return replicate_law(y, pl, std::span<double>(w.R.data(), n), std::span<double>(w.L.data(), n), law) &&
+         ks_distance_reaches(y, law, D);
 }
 }  // namespace
 
