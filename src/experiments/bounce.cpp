@@ -7,12 +7,16 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <functional>
+#include <span>
 #include <ostream>
 #include <limits>
 #include <locale>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+
+#include <boost/sort/pdqsort/pdqsort.hpp>
 
 #include "asperity/core/contact.hpp"
 #include "asperity/core/impact.hpp"
@@ -427,17 +431,27 @@ GroupSums collect_group(const BounceSamples& s, const BounceExperiment& b, const
   return t;
 }
 
+// What the KS of a group's residuals against its semi-analytic law needs: the sorted residuals
+// (a window's are its g.sorted) and the members per impact number. Run beside the bootstrap
+// replicates (bootstrap_tests): the largest window's test alone took as long as all other groups.
+struct TheoryInput {
+  bool active = false;
+  std::vector<double> res;  ///< sorted; empty when they are the group's g.sorted
+  std::vector<std::size_t> kcount;
+};
+
 // KS of the group's residuals against the mixture of the per-impact laws of its members.
-void residual_theory_test(GroupSums& t, const std::vector<BounceResidualLaw>& laws, BounceGroup& g) {
-  const double n = static_cast<double>(t.res.size());
+void residual_theory_test(std::span<const double> res, const std::vector<std::size_t>& kcount,
+                          const std::vector<BounceResidualLaw>& laws, BounceGroup& g) {
+  const double n = static_cast<double>(res.size());
   std::vector<std::pair<double, const BounceResidualLaw*>> mix;
-  for (std::size_t k = 1; k < t.kcount.size(); ++k)
-    if (t.kcount[k]) mix.push_back({static_cast<double>(t.kcount[k]) / n, &laws[k - 1]});
+  for (std::size_t k = 1; k < kcount.size(); ++k)
+    if (kcount[k]) mix.push_back({static_cast<double>(kcount[k]) / n, &laws[k - 1]});
   double wsum = 0;
   for (const auto& m : mix) wsum += m.first;
   if (mix.empty() || !(wsum > 0.999999)) return;
   g.has_theory = true;
-  g.theory_ks = ks_one_sample(t.res, [&mix](double x) {
+  g.theory_ks = ks_one_sample(res, [&mix](double x) {
     double F = 0;
     for (const auto& [w, L] : mix) F += w * L->cdf(x);
     return F;
@@ -445,8 +459,9 @@ void residual_theory_test(GroupSums& t, const std::vector<BounceResidualLaw>& la
   if (mix.size() == 1) g.theory_rate_below = mix[0].second->rate_below(), g.theory_rate_above = mix[0].second->rate_above();
 }
 
-// Residual mean, spread, speed correlation, Eq. 2 fit and the semi-analytic law of the residuals.
-void residual_statistics(GroupSums& t, const std::vector<BounceResidualLaw>& laws, BounceGroup& g) {
+// Residual mean, spread, speed correlation and Eq. 2 fit; sorts t.res (pdqsort: the same sorted
+// values as std::sort, faster).
+void residual_statistics(GroupSums& t, BounceGroup& g) {
   if (t.res.size() <= 2) return;
   const double n = static_cast<double>(t.res.size());
   const double mr = t.cr / n, vr = std::max(0.0, t.crr / n - mr * mr), vu = std::max(0.0, t.cuu / n - t.cu / n * t.cu / n);
@@ -454,14 +469,13 @@ void residual_statistics(GroupSums& t, const std::vector<BounceResidualLaw>& law
   g.residual_std = std::sqrt(vr * n / (n - 1));
   const double den = std::sqrt(vr * vu);
   g.speed_residual_correlation = {den > 0 ? (t.cur / n - t.cu / n * mr) / den : kNaN, 1.0 / std::sqrt(n)};
-  std::sort(t.res.begin(), t.res.end());
+  boost::sort::pdqsort_branchless(t.res.begin(), t.res.end());
   try {
     g.residual_fit = fit_asymmetric_laplace_sorted(t.res);
     g.residual_fitted = t.res.size() >= 20;
   } catch (const std::invalid_argument&) {
     g.residual_fitted = false;
   }
-  if (!laws.empty()) residual_theory_test(t, laws, g);
 }
 
 // Mean speed and spin, mean and spread of the group's quantity, eps(times) - eps(velocities).
@@ -510,7 +524,7 @@ void laplace_fit(BounceGroup& g) {
 // for the big low-speed windows; a group left with floor >= alpha is undecided when no
 // replicate reaches D (bootstrap_verdict), never accepted.
 void bootstrap_tests(const BounceExperiment& b, std::uint64_t seed, const std::vector<std::uint64_t>& index,
-                     std::vector<BounceGroup>& groups) {
+                     std::vector<BounceGroup>& groups, std::span<const std::function<void()>> beside) {
   std::vector<GofJob> jobs;
   std::vector<std::size_t> of;  // the group of each job
   for (std::size_t j = 0; j < groups.size(); ++j) {
@@ -523,7 +537,7 @@ void bootstrap_tests(const BounceExperiment& b, std::uint64_t seed, const std::v
     jobs.push_back({g.sorted, &g.fit, bootstrap_count(b, g.n), index[j], SequentialStop{b.bootstrap_stop, b.alpha}});
     of.push_back(j);
   }
-  const auto gof = laplace_gof_batch(jobs, seed);
+  const auto gof = laplace_gof_batch(jobs, seed, beside);
   for (std::size_t i = 0; i < jobs.size(); ++i) {
     auto& g = groups[of[i]];
     g.gof = gof[i];
@@ -544,7 +558,7 @@ struct GroupSpec {
 };
 
 BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const std::vector<BounceResidualLaw>& laws,
-                       const std::vector<double>& en_u, const GroupSpec& spec, std::size_t n) {
+                       const std::vector<double>& en_u, const GroupSpec& spec, std::size_t n, TheoryInput& th) {
   BounceGroup g;
   g.by = spec.window ? "speed" : "impact", g.lo = spec.lo, g.hi = spec.hi;
   g.quantity = spec.window ? "eps-eps_n(u)" : "eps";
@@ -552,11 +566,17 @@ BounceGroup make_group(const BounceSamples& s, const BounceExperiment& b, const 
   GroupSums t = spec.window ? collect_group(s, b, en_u, laws.size(), n, true,
                                             [&](std::size_t j) { return s.speed[j] >= spec.lo && s.speed[j] <= spec.hi; }, g)
                             : collect_group(s, b, en_u, laws.size(), n, false, [&](std::size_t j) { return s.number[j] == k; }, g);
-  residual_statistics(t, laws, g);  // sorts t.res (n > 2)
+  residual_statistics(t, g);  // sorts t.res (n > 2)
   group_moments(t, g);
+  th.active = t.res.size() > 2 && !laws.empty();
+  th.kcount = std::move(t.kcount);
   // A window's quantity is its residual, already sorted above: the same values, one sort fewer.
-  if (spec.window && std::is_sorted(t.res.begin(), t.res.end())) g.sorted = std::move(t.res);
-  else std::sort(g.sorted.begin(), g.sorted.end());
+  if (spec.window && std::is_sorted(t.res.begin(), t.res.end())) {
+    g.sorted = std::move(t.res);
+  } else {
+    boost::sort::pdqsort_branchless(g.sorted.begin(), g.sorted.end());
+    if (th.active) th.res = std::move(t.res);
+  }
   laplace_fit(g);
   return g;
 }
@@ -581,20 +601,29 @@ std::vector<BounceGroup> make_groups(const BounceSamples& s, const BounceExperim
   }
   for (std::size_t g = 0; g < order.size(); ++g) order[g] = g;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return n[x] > n[y]; });
+  std::vector<TheoryInput> theory(specs.size());
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t i = 0; i < m; ++i) {
     const auto j = order[static_cast<std::size_t>(i)];
     try {
-      groups[j] = make_group(s, b, laws, en_u, specs[j], n[j]);
+      groups[j] = make_group(s, b, laws, en_u, specs[j], n[j], theory[j]);
     } catch (...) {
       errors[j] = std::current_exception();  // an exception must not leave the parallel region
     }
   }
   for (const auto& e : errors)
     if (e) std::rethrow_exception(e);
+  // The semi-analytic law's KS tests run beside the bootstrap replicates, largest first.
+  std::vector<std::function<void()>> tests;
+  for (std::size_t j : order)
+    if (theory[j].active)
+      tests.emplace_back([&, j] {
+        const std::span<const double> res = theory[j].res.empty() ? std::span<const double>(groups[j].sorted) : theory[j].res;
+        residual_theory_test(res, theory[j].kcount, laws, groups[j]);
+      });
   std::vector<std::uint64_t> index;
   for (const auto& sp : specs) index.push_back(sp.index);
-  bootstrap_tests(b, seed, index, groups);
+  bootstrap_tests(b, seed, index, groups, tests);
   return groups;
 }
 

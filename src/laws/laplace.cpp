@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <mutex>
 #include <utility>
@@ -271,7 +272,8 @@ LaplaceGof result_of(const GofJob& job, const JobState& st, double D) {
 }
 }  // namespace
 
-std::vector<LaplaceGof> laplace_gof_batch(std::span<const GofJob> jobs, std::uint64_t seed) {
+std::vector<LaplaceGof> laplace_gof_batch(std::span<const GofJob> jobs, std::uint64_t seed,
+                                          std::span<const std::function<void()>> beside) {
   const std::size_t nj = jobs.size();
   std::vector<double> D(nj), pl(nj);
   std::vector<JobState> state(nj);
@@ -288,20 +290,33 @@ std::vector<LaplaceGof> laplace_gof_batch(std::span<const GofJob> jobs, std::uin
   // Largest work first: the big tests' replicates are shared by all threads from the start.
   auto work = [&](std::size_t j) { return static_cast<double>(jobs[j].sorted.size()) * static_cast<double>(jobs[j].bootstrap); };
   std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return work(x) > work(y); });
-  std::vector<std::pair<std::size_t, std::size_t>> items;  // (job, replicate) in that order
+  // (job, replicate) in that order, after the caller's tasks (job = nj: task `replicate`)
+  std::vector<std::pair<std::size_t, std::size_t>> items;
+  for (std::size_t t = 0; t < beside.size(); ++t) items.emplace_back(nj, t);
   for (std::size_t j : order)
     for (std::size_t b = 0; b < jobs[j].bootstrap; ++b) items.emplace_back(j, b);
   const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
   std::vector<ReplicateScratch> scratch(static_cast<std::size_t>(threads));
+  std::vector<std::exception_ptr> errors(beside.size());
   const auto m = static_cast<std::int64_t>(items.size());
 #pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (m > 1)
   for (std::int64_t i = 0; i < m; ++i) {
     const auto [j, b] = items[static_cast<std::size_t>(i)];
+    if (j == nj) {
+      try {
+        beside[b]();
+      } catch (...) {
+        errors[b] = std::current_exception();  // must not leave the parallel region
+      }
+      continue;
+    }
     if (finished(state[j])) continue;  // past the stop: would be discarded
     const bool e = replicate_exceeds(*jobs[j].fit, pl[j], D[j], jobs[j].sorted.size(), seed, jobs[j].stream_index, b,
                                      scratch[static_cast<std::size_t>(omp_get_thread_num())]);
     record(state[j], jobs[j], b, e);
   }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
   std::vector<LaplaceGof> out;
   out.reserve(nj);
   for (std::size_t j = 0; j < nj; ++j) out.push_back(result_of(jobs[j], state[j], D[j]));

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <stdexcept>
 #include <limits>
 #include <vector>
 
@@ -237,7 +239,15 @@ TEST(Laplace, BatchEqualsOneTestAtATime) {
   EXPECT_EQ(alone[1].exceedances, 0u);  // p = 1/(1 + B) = 0.01
   for (int threads : {1, 2}) {
     omp_set_num_threads(threads);
-    const auto batch = laplace_gof_batch(jobs, 9);
+    // Tasks beside the replicates run once each and leave the results alone; a throwing task's
+    // exception comes out after the loop.
+    std::vector<int> ran(5, 0);
+    std::vector<std::function<void()>> beside;
+    for (std::size_t t = 0; t < ran.size(); ++t) beside.emplace_back([&ran, t] { ++ran[t]; });
+    const auto batch = laplace_gof_batch(jobs, 9, beside);
+    EXPECT_EQ(ran, std::vector<int>(5, 1));
+    beside.emplace_back([] { throw std::runtime_error("task"); });
+    EXPECT_THROW(laplace_gof_batch(jobs, 9, beside), std::runtime_error);
     ASSERT_EQ(batch.size(), jobs.size());
     for (std::size_t j = 0; j < jobs.size(); ++j) {
       EXPECT_EQ(batch[j].D, alone[j].D) << j;
