@@ -8,9 +8,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <iomanip>
 #include <locale>
 #include <sstream>
+#include <thread>
+#include <vector>
 
 #include "asperity/app/plot.hpp"
 #include "asperity/core/restitution.hpp"
@@ -211,61 +214,86 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
   return j.dump(2) + "\n";
 }
 
+namespace {
+// One variant's figure: its speed windows' histograms and fitted Eq. 2 densities.
+void write_bounce_plot(const std::filesystem::path& png, const BounceVariantReport& r, const std::vector<const BounceGroup*>& gs) {
+  auto script = [&](const std::filesystem::path& out) {
+    std::ostringstream s;
+    s.imbue(std::locale::classic());
+    s.precision(10);
+    static const char* colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"};
+    double ymin = 1e300, ymax = 0, xlo = 1e300, xhi = -1e300;
+    for (std::size_t k = 0; k < gs.size(); ++k) {
+      const auto& g = *gs[k];
+      const auto& f = g.fit.law;
+      // eps - m in units of 1e-6, range from the 0.1% and 99.9% sample quantiles.
+      const double lo = (quantile_sorted(g.sorted, 0.001) - f.m) * 1e6, hi = (quantile_sorted(g.sorted, 0.999) - f.m) * 1e6;
+      std::vector<double> x(g.sorted.size());
+      for (std::size_t i = 0; i < x.size(); ++i) x[i] = (g.sorted[i] - f.m) * 1e6;
+      const auto h = make_histogram(x, lo, hi, 60);
+      s << "$h" << k << " << EOD\n";
+      for (std::size_t i = 0; i < h.bins(); ++i)
+        if (h.counts[i] > 0) {
+          s << h.centre(i) << ' ' << h.density(i) << ' ' << h.density_se(i) << '\n';
+          ymin = std::min(ymin, h.density(i)), ymax = std::max(ymax, h.density(i));
+        }
+      s << "EOD\n$f" << k << " << EOD\n";
+      for (int i = 0; i <= 400; ++i) {
+        const double t = lo + (hi - lo) * i / 400.0;
+        s << t << ' ' << f.pdf(f.m + t * 1e-6) * 1e-6 << '\n';
+      }
+      s << "EOD\n";
+      xlo = std::min(xlo, lo), xhi = std::max(xhi, hi);
+    }
+    s << "set encoding utf8\nset terminal pngcairo size 900,650 enhanced font 'sans,12'\nset output '" << gp_quote(out.string()) << "'\n"
+      << "set logscale y\nset format y '10^{%L}'\nset xrange [" << xlo << ":" << xhi << "]\nset yrange [" << ymin / 3 << ":"
+      << ymax * 3 << "]\n"
+      << "set xlabel '{/Symbol e} - {/Symbol e}_n(u) - m [10^{-6}]'\nset ylabel 'probability density [1/10^{-6}]'\n"
+      << "set key top left\nset title 'Fig. 6, " << to_string(r.variant) << ": impact-speed windows, fitted asymmetric Laplace (Eq. 2)'\n"
+      << "plot ";
+    for (std::size_t k = 0; k < gs.size(); ++k) {
+      const auto& g = *gs[k];
+      const char* col = colours[k % 6];
+      s << (k ? ", \\\n  " : "") << "$h" << k << " using 1:2:3 with yerrorbars pointtype 7 pointsize 0.5 lc rgb '" << col
+        << "' title 'u in [" << g.lo << "," << g.hi << "] m/s (n = " << g.n << ")', $f" << k
+        << " using 1:2 with lines lw 2 lc rgb '" << col << "' notitle";
+    }
+    s << "\nunset output\n";
+    return s.str();
+  };
+  write_gnuplot_png(png, script);
+}
+}  // namespace
+
 std::vector<std::string> write_bounce_plots(const std::filesystem::path& dir, const std::vector<BounceVariantReport>& reports) {
   std::vector<std::string> files;
+  std::vector<std::vector<const BounceGroup*>> groups;
+  std::vector<const BounceVariantReport*> of;
   for (const auto& r : reports) {
     std::vector<const BounceGroup*> gs;
     for (const auto& g : r.groups)
       if (g.by == "speed" && g.fitted) gs.push_back(&g);
     if (gs.empty()) continue;
-    const std::string name = "fig6_" + std::string(to_string(r.variant)) + ".png";
-    auto script = [&](const std::filesystem::path& out) {
-      std::ostringstream s;
-      s.imbue(std::locale::classic());
-      s.precision(10);
-      static const char* colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"};
-      double ymin = 1e300, ymax = 0, xlo = 1e300, xhi = -1e300;
-      for (std::size_t k = 0; k < gs.size(); ++k) {
-        const auto& g = *gs[k];
-        const auto& f = g.fit.law;
-        // eps - m in units of 1e-6, range from the 0.1% and 99.9% sample quantiles.
-        const double lo = (quantile_sorted(g.sorted, 0.001) - f.m) * 1e6, hi = (quantile_sorted(g.sorted, 0.999) - f.m) * 1e6;
-        std::vector<double> x(g.sorted.size());
-        for (std::size_t i = 0; i < x.size(); ++i) x[i] = (g.sorted[i] - f.m) * 1e6;
-        const auto h = make_histogram(x, lo, hi, 60);
-        s << "$h" << k << " << EOD\n";
-        for (std::size_t i = 0; i < h.bins(); ++i)
-          if (h.counts[i] > 0) {
-            s << h.centre(i) << ' ' << h.density(i) << ' ' << h.density_se(i) << '\n';
-            ymin = std::min(ymin, h.density(i)), ymax = std::max(ymax, h.density(i));
-          }
-        s << "EOD\n$f" << k << " << EOD\n";
-        for (int i = 0; i <= 400; ++i) {
-          const double t = lo + (hi - lo) * i / 400.0;
-          s << t << ' ' << f.pdf(f.m + t * 1e-6) * 1e-6 << '\n';
-        }
-        s << "EOD\n";
-        xlo = std::min(xlo, lo), xhi = std::max(xhi, hi);
-      }
-      s << "set encoding utf8\nset terminal pngcairo size 900,650 enhanced font 'sans,12'\nset output '" << gp_quote(out.string()) << "'\n"
-        << "set logscale y\nset format y '10^{%L}'\nset xrange [" << xlo << ":" << xhi << "]\nset yrange [" << ymin / 3 << ":"
-        << ymax * 3 << "]\n"
-        << "set xlabel '{/Symbol e} - {/Symbol e}_n(u) - m [10^{-6}]'\nset ylabel 'probability density [1/10^{-6}]'\n"
-        << "set key top left\nset title 'Fig. 6, " << to_string(r.variant) << ": impact-speed windows, fitted asymmetric Laplace (Eq. 2)'\n"
-        << "plot ";
-      for (std::size_t k = 0; k < gs.size(); ++k) {
-        const auto& g = *gs[k];
-        const char* col = colours[k % 6];
-        s << (k ? ", \\\n  " : "") << "$h" << k << " using 1:2:3 with yerrorbars pointtype 7 pointsize 0.5 lc rgb '" << col
-          << "' title 'u in [" << g.lo << "," << g.hi << "] m/s (n = " << g.n << ")', $f" << k
-          << " using 1:2 with lines lw 2 lc rgb '" << col << "' notitle";
-      }
-      s << "\nunset output\n";
-      return s.str();
-    };
-    write_gnuplot_png(dir / name, script);
-    files.push_back(name);
+    files.push_back("fig6_" + std::string(to_string(r.variant)) + ".png");
+    groups.push_back(std::move(gs)), of.push_back(&r);
   }
+  // One gnuplot process per figure, side by side (as write_figures); the first failure in order
+  // is reported (the run's own cleanup removes the figures it wrote).
+  std::vector<std::exception_ptr> errors(files.size());
+  {
+    std::vector<std::thread> workers;
+    for (std::size_t i = 0; i < files.size(); ++i)
+      workers.emplace_back([&, i] {
+        try {
+          write_bounce_plot(dir / files[i], *of[i], groups[i]);
+        } catch (...) {
+          errors[i] = std::current_exception();
+        }
+      });
+    for (auto& w : workers) w.join();
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
   return files;
 }
 

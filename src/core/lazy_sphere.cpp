@@ -145,12 +145,36 @@ void LazySphere::fill(std::size_t i) {
   const Node& c = nodes_[i];
   Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id + 1);
   nodes_[i].points = static_cast<std::int64_t>(points_.size());
+  // Drawn now (the stream's order), converted to Cartesian when a query needs them (centre()).
   for (std::uint64_t j = 0; j < c.count; ++j) {
     const double z = c.z0 + (c.z1 - c.z0) * s.uniform0();
     const double phi = c.p0 + (c.p1 - c.p0) * s.uniform0();
-    const double r = rim(z);
-    points_.emplace_back(r * std::cos(phi), r * std::sin(phi), z);
+    points_.emplace_back(kDeferred, z, phi);
   }
+}
+
+const Vec3& LazySphere::centre(std::size_t p) {
+  Vec3& u = points_[p];
+  if (std::isnan(u.x())) {
+    const double z = u.y(), phi = u.z(), r = rim(z);
+    u = Vec3(r * std::cos(phi), r * std::sin(phi), z);
+  }
+  return u;
+}
+
+double LazySphere::deferred_lower_key(const Vec3& zphi, const Direction& q) {
+  // u.d = s(z) dxy cos(phi - psi) + z dz with s, dxy >= 0, and cos x <= 1 - x^2/2 + x^4/24 for
+  // every real x (the difference is even, 0 at 0 and increasing for x > 0, as sin x >= x - x^3/6),
+  // so no cos or sin is needed to bound the key. x = phi - psi is reduced to (-pi, pi] only to
+  // keep the bound tight; its rounding (~1e-15) and the point's own (as in lower_key) are far
+  // inside the 1e-13 margin.
+  constexpr double pi = std::numbers::pi;
+  const double z = zphi.y();
+  double x = zphi.z() - q.psi;  // in (-pi, 3 pi)
+  if (x > pi) x -= 2.0 * pi;
+  const double x2 = x * x;
+  const double cub = std::min(1.0, 1.0 - x2 * (0.5 - x2 * (1.0 / 24.0)));
+  return 2.0 - 2.0 * (rim(z) * q.dxy * cub + z * q.d.z()) - 1e-13;
 }
 
 double LazySphere::lower_key(const Node& c, const Direction& q) {
@@ -210,8 +234,13 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
     if (is_leaf(nodes_[i])) {
       if (nodes_[i].points < 0) fill(i);
       const Node& c = nodes_[i];
-      for (std::uint64_t j = 0; j < c.count; ++j)
-        top.offer(static_cast<std::uint32_t>(c.offset + j), contact_key(points_[static_cast<std::size_t>(c.points) + j], d));
+      for (std::uint64_t j = 0; j < c.count; ++j) {
+        const std::size_t p = static_cast<std::size_t>(c.points) + j;
+        // A centre not converted yet whose key cannot beat the runner-up would leave `top` as it
+        // is (offer ignores keys above the second): it stays unconverted (no cos, sin, sqrt).
+        if (std::isnan(points_[p].x()) && deferred_lower_key(points_[p], q) > top.second_key()) continue;
+        top.offer(static_cast<std::uint32_t>(c.offset + j), contact_key(centre(p), d));
+      }
       continue;
     }
     if (nodes_[i].child < 0) expand(i);
@@ -240,7 +269,7 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
     const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
     i = idx < nodes_[ch + 1].offset ? ch : ch + 1;
   }
-  r.u = points_[static_cast<std::size_t>(nodes_[i].points) + (idx - nodes_[i].offset)];
+  r.u = centre(static_cast<std::size_t>(nodes_[i].points) + (idx - nodes_[i].offset));
   return r;
 }
 
@@ -256,7 +285,7 @@ std::vector<Vec3> LazySphere::materialise() {
     if (is_leaf(nodes_[i])) {
       if (nodes_[i].points < 0) fill(i);
       const auto p = static_cast<std::size_t>(nodes_[i].points);
-      for (std::uint64_t j = 0; j < nodes_[i].count; ++j) out.push_back(points_[p + j]);
+      for (std::uint64_t j = 0; j < nodes_[i].count; ++j) out.push_back(centre(p + j));
       continue;
     }
     if (nodes_[i].child < 0) expand(i);

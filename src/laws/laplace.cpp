@@ -5,7 +5,10 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <mutex>
+#include <utility>
 #include <stdexcept>
 #include <string>
 
@@ -144,7 +147,7 @@ namespace {
 // uniform order statistics are U_(i) = S_i/S_(n+1), S the partial sums of n + 1 standard exponentials
 // (Renyi), mapped through the quantile. Both tails are computed from their own side (S_i for the
 // lower, S_(n+1) - S_i as suffix sums for the upper), so no 1 - U cancels. `tail` is scratch (n + 1).
-void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::vector<double>& y, std::vector<double>& tail) {
+void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::span<double> y, std::span<double> tail) {
   const std::size_t n = y.size();
   for (auto& e : y) e = -std::log(s.uniform());  // E_1 .. E_n (held in y until overwritten)
   const double last = -std::log(s.uniform());    // E_(n+1)
@@ -155,8 +158,9 @@ void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::vector<double>& y
   double lower = 0;
   for (std::size_t i = 0; i < n; ++i) {
     lower += y[i];  // S_(i+1)
-    const double p = lower / total, q = tail[i + 1] / total;
-    y[i] = p < pl ? L.m + std::log(p / pl) / a : L.m - std::log(q / (1.0 - pl)) / c;
+    const double p = lower / total;
+    if (p < pl) y[i] = L.m + std::log(p / pl) / a;
+    else y[i] = L.m - std::log(tail[i + 1] / total / (1.0 - pl)) / c;  // q = tail / total only here
   }
   // Rounding in the two sums can break monotonicity by an ulp near the mode: restore it.
   for (std::size_t i = 1; i < n; ++i) y[i] = std::max(y[i], y[i - 1]);
@@ -171,10 +175,10 @@ namespace {
 // so on [j0, j1] every g_j >= sqrt(L_j0) + sqrt(R_j1); a block whose bound exceeds the best g so
 // far (started at the generating law's mode, where the minimum lies) is skipped. False when all
 // values are equal (no minimum).
-bool replicate_law(std::span<const double> t, double pl, std::vector<double>& R, std::vector<double>& L,
+bool replicate_law(std::span<const double> t, double pl, std::span<double> R, std::span<double> L,
                    AsymmetricLaplace& law) {
   const std::size_t n = t.size();
-  R.assign(n, 0.0), L.assign(n, 0.0);
+  R[n - 1] = 0, L[0] = 0;  // every other entry is written below
   for (std::size_t j = n - 1; j > 0; --j) R[j - 1] = R[j] + static_cast<double>(n - j) * (t[j] - t[j - 1]);
   for (std::size_t j = 1; j < n; ++j) L[j] = L[j - 1] + static_cast<double>(j) * (t[j] - t[j - 1]);
   double best = std::numeric_limits<double>::infinity();
@@ -203,56 +207,126 @@ bool replicate_law(std::span<const double> t, double pl, std::vector<double>& R,
 }  // namespace
 
 namespace {
+// Only grows: a thread moves between tests of different n, and regrowing a vector would zero it
+// (the replicate writes every entry it reads).
 struct ReplicateScratch {
   std::vector<double> y, tail, R, L;
+  void fit(std::size_t n) {
+    if (y.size() < n) y.resize(n), tail.resize(n + 1), R.resize(n), L.resize(n);
+  }
 };
 
 // Whether replicate b of the bootstrap reaches the data's distance D.
 bool replicate_exceeds(const LaplaceFit& fit, double pl, double D, std::size_t n, std::uint64_t seed,
                        std::uint64_t stream_index, std::size_t b, ReplicateScratch& w) {
-  w.y.resize(n), w.tail.resize(n + 1);
+  w.fit(n);
+  const std::span<double> y(w.y.data(), n);
   Stream s(seed, Purpose::analysis, stream_index, static_cast<std::uint64_t>(b) + 1);
-  sorted_sample(fit.law, s, w.y, w.tail);
+  sorted_sample(fit.law, s, y, std::span<double>(w.tail.data(), n + 1));
   AsymmetricLaplace law;
-  return replicate_law(w.y, pl, w.R, w.L, law) && ks_distance_reaches(w.y, law, D);
+  return replicate_law(y, pl, std::span<double>(w.R.data(), n), std::span<double>(w.L.data(), n), law) &&
+         ks_distance_reaches(y, law, D);
 }
 }  // namespace
 
+namespace {
+// A job's replicates as they finish, folded into K and L in replicate order.
+struct JobState {
+  std::mutex m;
+  std::vector<std::int8_t> exceed;  // per replicate: -1 not known yet, else 0 / 1
+  std::size_t next = 0, k = 0;      // replicates [0, next) folded in, k of them >= D
+  bool stopped = false;             // the stop rule held after replicate next - 1
+};
+
+bool stop_holds(const SequentialStop& stop, std::size_t k, std::size_t done, std::size_t B) {
+  const double kd = static_cast<double>(k);
+  return stop.exceedances > 0 && k >= stop.exceedances && kd / static_cast<double>(done) >= stop.alpha &&
+         (kd + 1.0) / (static_cast<double>(B) + 1.0) >= stop.alpha;
+}
+
+// Records replicate b and folds in every replicate now known in order, as a sequential loop
+// would: the stop happens at the same replicate whatever order the threads finish in.
+void record(JobState& st, const GofJob& job, std::size_t b, bool exceeds) {
+  std::lock_guard<std::mutex> lock(st.m);
+  st.exceed[b] = exceeds ? 1 : 0;
+  while (!st.stopped && st.next < job.bootstrap && st.exceed[st.next] >= 0) {
+    st.k += static_cast<std::size_t>(st.exceed[st.next++]);
+    st.stopped = stop_holds(job.stop, st.k, st.next, job.bootstrap);
+  }
+}
+
+bool finished(JobState& st) {
+  std::lock_guard<std::mutex> lock(st.m);
+  return st.stopped;
+}
+
+LaplaceGof result_of(const GofJob& job, const JobState& st, double D) {
+  LaplaceGof g;
+  g.D = D;
+  g.bootstrap = job.bootstrap;
+  g.replicates = st.next, g.exceedances = st.k;
+  g.stopped_early = st.stopped && st.next < job.bootstrap;
+  g.p = g.stopped_early ? static_cast<double>(st.k) / static_cast<double>(st.next)
+                        : (1.0 + static_cast<double>(st.k)) / (1.0 + static_cast<double>(job.bootstrap));
+  return g;
+}
+}  // namespace
+
+std::vector<LaplaceGof> laplace_gof_batch(std::span<const GofJob> jobs, std::uint64_t seed,
+                                          std::span<const std::function<void()>> beside) {
+  const std::size_t nj = jobs.size();
+  std::vector<double> D(nj), pl(nj);
+  std::vector<JobState> state(nj);
+  std::vector<std::size_t> order(nj);
+#pragma omp parallel for schedule(dynamic, 1) if (nj > 1)
+  for (std::int64_t jj = 0; jj < static_cast<std::int64_t>(nj); ++jj) {
+    const auto j = static_cast<std::size_t>(jj);
+    D[j] = ks_distance(jobs[j].sorted, jobs[j].fit->law);
+    const auto& law = jobs[j].fit->law;
+    pl[j] = law.c() / (law.a() + law.c());  // P(t < m) of the generating law
+    state[j].exceed.assign(jobs[j].bootstrap, -1);
+    order[j] = j;
+  }
+  // Largest work first: the big tests' replicates are shared by all threads from the start.
+  auto work = [&](std::size_t j) { return static_cast<double>(jobs[j].sorted.size()) * static_cast<double>(jobs[j].bootstrap); };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return work(x) > work(y); });
+  // (job, replicate) in that order, after the caller's tasks (job = nj: task `replicate`)
+  std::vector<std::pair<std::size_t, std::size_t>> items;
+  for (std::size_t t = 0; t < beside.size(); ++t) items.emplace_back(nj, t);
+  for (std::size_t j : order)
+    for (std::size_t b = 0; b < jobs[j].bootstrap; ++b) items.emplace_back(j, b);
+  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
+  std::vector<ReplicateScratch> scratch(static_cast<std::size_t>(threads));
+  std::vector<std::exception_ptr> errors(beside.size());
+  const auto m = static_cast<std::int64_t>(items.size());
+#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (m > 1)
+  for (std::int64_t i = 0; i < m; ++i) {
+    const auto [j, b] = items[static_cast<std::size_t>(i)];
+    if (j == nj) {
+      try {
+        beside[b]();
+      } catch (...) {
+        errors[b] = std::current_exception();  // must not leave the parallel region
+      }
+      continue;
+    }
+    if (finished(state[j])) continue;  // past the stop: would be discarded
+    const bool e = replicate_exceeds(*jobs[j].fit, pl[j], D[j], jobs[j].sorted.size(), seed, jobs[j].stream_index, b,
+                                     scratch[static_cast<std::size_t>(omp_get_thread_num())]);
+    record(state[j], jobs[j], b, e);
+  }
+  for (const auto& e : errors)
+    if (e) std::rethrow_exception(e);
+  std::vector<LaplaceGof> out;
+  out.reserve(nj);
+  for (std::size_t j = 0; j < nj; ++j) out.push_back(result_of(jobs[j], state[j], D[j]));
+  return out;
+}
+
 LaplaceGof laplace_gof(std::span<const double> sorted, const LaplaceFit& fit, std::size_t bootstrap, std::uint64_t seed,
                        std::uint64_t stream_index, SequentialStop stop) {
-  LaplaceGof g;
-  g.D = ks_distance(sorted, fit.law);
-  g.bootstrap = bootstrap;
-  const std::size_t n = sorted.size(), B = bootstrap;
-  const double pl = fit.law.c() / (fit.law.a() + fit.law.c());  // P(t < m) of the generating law
-  // Without a stop all B replicates form one parallel batch; with one, batches of one replicate
-  // per thread are decided in replicate order (the replicates past the stop are discarded).
-  const int threads = omp_in_parallel() ? 1 : omp_get_max_threads();
-  const std::size_t batch = stop.exceedances == 0 ? std::max<std::size_t>(B, 1) : static_cast<std::size_t>(threads);
-  std::vector<ReplicateScratch> scratch(static_cast<std::size_t>(threads));
-  std::vector<std::uint8_t> exceed(B, 0);
-  std::size_t k = 0, done = 0;
-  for (std::size_t b0 = 0; b0 < B && !g.stopped_early; b0 += batch) {
-    const auto b1 = static_cast<std::int64_t>(std::min(B, b0 + batch));
-#pragma omp parallel for schedule(dynamic, 1) num_threads(threads) if (b1 - static_cast<std::int64_t>(b0) > 1)
-    for (std::int64_t b = static_cast<std::int64_t>(b0); b < b1; ++b)
-      exceed[static_cast<std::size_t>(b)] =
-          replicate_exceeds(fit, pl, g.D, n, seed, stream_index, static_cast<std::size_t>(b),
-                            scratch[static_cast<std::size_t>(omp_get_thread_num())]) ? 1 : 0;
-    for (std::size_t b = b0; b < static_cast<std::size_t>(b1); ++b) {
-      k += exceed[b], done = b + 1;
-      const double kd = static_cast<double>(k);
-      if (stop.exceedances > 0 && k >= stop.exceedances && kd / static_cast<double>(done) >= stop.alpha &&
-          (kd + 1.0) / (static_cast<double>(B) + 1.0) >= stop.alpha) {
-        g.stopped_early = done < B;
-        break;
-      }
-    }
-  }
-  g.replicates = done, g.exceedances = k;
-  g.p = g.stopped_early ? static_cast<double>(k) / static_cast<double>(done)
-                        : (1.0 + static_cast<double>(k)) / (1.0 + static_cast<double>(bootstrap));
-  return g;
+  const GofJob job{sorted, &fit, bootstrap, stream_index, stop};
+  return laplace_gof_batch(std::span<const GofJob>(&job, 1), seed).front();
 }
 
 }  // namespace asperity

@@ -41,6 +41,13 @@ TEST(LazySphere, QueriesEqualBruteForceOnTheMaterialisedSphere) {
       const Vec3 a = centres[(i * 31) % n], b = centres[(i * 31 + 1) % n];
       if ((a + b).norm() > 1e-3) dirs.push_back((a + b).normalized());
     }
+    // The poles (dxy = 0) and the seam phi = 0 = 2 pi, where psi = atan2 jumps from pi to -pi
+    // (the deferred centres' bound reduces phi - psi across it).
+    for (double e : {0.0, 1e-300, 1e-15, 1e-9, 1e-4})
+      for (double sz : {-1.0, 1.0}) {
+        dirs.push_back(Vec3(e, 0, sz).normalized()), dirs.push_back(Vec3(-1, e, sz * 1e-3).normalized());
+        dirs.push_back(Vec3(-1, -e, sz * 0.3).normalized()), dirs.push_back(Vec3(1, sz * e, 0.1).normalized());
+      }
     for (const auto& d : dirs) {
       const auto got = lazy.lowest(d);
       const auto want = brute_lowest(centres, d);

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <stdexcept>
 #include <limits>
 #include <vector>
 
@@ -210,6 +212,52 @@ TEST(Laplace, SequentialStopKeepsTheVerdict) {
   const auto g2 = laplace_gof(samples[0], f0, 99, 4, 0, SequentialStop{5, 0.01});
   EXPECT_EQ(g1.p, g2.p);
   EXPECT_EQ(g1.replicates, g2.replicates);
+}
+
+TEST(Laplace, BatchEqualsOneTestAtATime) {
+  // laplace_gof_batch runs the replicates of several tests in one loop (shared scratch across tests
+  // of different n, a test's stop decided while other tests' replicates are in flight): every
+  // result must equal that test alone on one thread, bit for bit, at 1 and 2 threads. Mix: an
+  // accepted sample that stops early, a Gaussian (rejected, draws all B), one without a stop, a
+  // tiny B and B = 0.
+  const auto law = truth();
+  std::vector<std::vector<double>> x = {draw(law, 1500, 40), {}, draw(law, 300, 41), draw(law, 4000, 42), draw(law, 50, 43)};
+  Stream s(23, Purpose::test, 0);
+  for (int i = 0; i < 1500; ++i) x[1].push_back(0.9 + 3e-6 * std::sqrt(-2 * std::log(s.uniform())) * std::cos(2 * M_PI * s.uniform0()));
+  std::vector<LaplaceFit> fits;
+  for (auto& v : x) std::sort(v.begin(), v.end()), fits.push_back(fit_asymmetric_laplace_sorted(v));
+  const std::vector<GofJob> jobs = {{x[0], &fits[0], 99, 1, SequentialStop{5, 0.01}},
+                                    {x[1], &fits[1], 99, 2, SequentialStop{5, 0.01}},
+                                    {x[2], &fits[2], 40, 3, {}},
+                                    {x[3], &fits[3], 3, 4, SequentialStop{1, 0.2}},
+                                    {x[4], &fits[4], 0, 5, {}}};
+  omp_set_num_threads(1);
+  std::vector<LaplaceGof> alone;
+  for (const auto& j : jobs) alone.push_back(laplace_gof(j.sorted, *j.fit, j.bootstrap, 9, j.stream_index, j.stop));
+  EXPECT_TRUE(alone[0].stopped_early);
+  EXPECT_EQ(alone[1].replicates, 99u);
+  EXPECT_EQ(alone[1].exceedances, 0u);  // p = 1/(1 + B) = 0.01
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    // Tasks beside the replicates run once each and leave the results alone; a throwing task's
+    // exception comes out after the loop.
+    std::vector<int> ran(5, 0);
+    std::vector<std::function<void()>> beside;
+    for (std::size_t t = 0; t < ran.size(); ++t) beside.emplace_back([&ran, t] { ++ran[t]; });
+    const auto batch = laplace_gof_batch(jobs, 9, beside);
+    EXPECT_EQ(ran, std::vector<int>(5, 1));
+    beside.emplace_back([] { throw std::runtime_error("task"); });
+    EXPECT_THROW(laplace_gof_batch(jobs, 9, beside), std::runtime_error);
+    ASSERT_EQ(batch.size(), jobs.size());
+    for (std::size_t j = 0; j < jobs.size(); ++j) {
+      EXPECT_EQ(batch[j].D, alone[j].D) << j;
+      EXPECT_EQ(batch[j].p, alone[j].p) << j;
+      EXPECT_EQ(batch[j].replicates, alone[j].replicates) << j;
+      EXPECT_EQ(batch[j].exceedances, alone[j].exceedances) << j;
+      EXPECT_EQ(batch[j].stopped_early, alone[j].stopped_early) << j;
+      EXPECT_EQ(batch[j].bootstrap, jobs[j].bootstrap) << j;
+    }
+  }
 }
 
 TEST(Laplace, SequentialBootstrapIsCalibratedUnderTheNull) {

@@ -25,6 +25,7 @@
 // of a run (the same value, computed once per n).
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "asperity/core/contact.hpp"
@@ -99,6 +100,12 @@ class LazySphere {
     double dxy, psi, cpsi, spsi;
   };
   static double lower_key(const Node& c, const Direction& q);
+  // A leaf's centres are stored as drawn, (NaN, z, phi), and converted to (x, y, z) on first use:
+  // most centres of a visited leaf are ruled out by deferred_lower_key, a lower bound of their key
+  // from (z, phi) alone (the same centres, the same values once converted).
+  static constexpr double kDeferred = std::numeric_limits<double>::quiet_NaN();
+  const Vec3& centre(std::size_t p);
+  static double deferred_lower_key(const Vec3& zphi, const Direction& q);
 
   std::uint64_t n_, seed_, sphere_;
   unsigned leaf_size_;

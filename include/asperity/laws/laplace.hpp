@@ -23,6 +23,7 @@
 // Goodness of fit: KS with estimated parameters is not distribution-free, so its p-value comes
 // from a parametric bootstrap (refit on samples drawn from the fitted law; Lilliefors-type).
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -93,5 +94,25 @@ struct SequentialStop {
 /// thread count.
 LaplaceGof laplace_gof(std::span<const double> sorted, const LaplaceFit& fit, std::size_t bootstrap,
                        std::uint64_t seed, std::uint64_t stream_index, SequentialStop stop = {});
+
+/// One test of laplace_gof_batch: laplace_gof's arguments but the seed (`sorted` and `fit` must
+/// outlive the call).
+struct GofJob {
+  std::span<const double> sorted;
+  const LaplaceFit* fit = nullptr;
+  std::size_t bootstrap = 0;
+  std::uint64_t stream_index = 0;
+  SequentialStop stop;
+};
+
+/// Several laplace_gof at once: the replicates of all jobs in one parallel loop (largest n B
+/// first), so a large test's replicates are spread over the threads instead of one test per
+/// thread with the largest left running alone. result[j] equals laplace_gof(jobs[j] ..., seed)
+/// bit for bit, for any thread count: a job's stop is decided in its replicate order, and the
+/// replicates computed past it (at most one per thread) are discarded. `beside`: other work of the
+/// caller that shares the threads (each task run once, started before any replicate, in the given
+/// order; the first exception is rethrown after the loop), so that a long task does not run alone.
+std::vector<LaplaceGof> laplace_gof_batch(std::span<const GofJob> jobs, std::uint64_t seed,
+                                          std::span<const std::function<void()>> beside = {});
 
 }  // namespace asperity
