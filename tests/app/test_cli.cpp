@@ -179,6 +179,10 @@ TEST(CliScene, ATinySceneWritesAReportWithItsPlan) {
   // few percent of seeds; with the explicit drops' Marsaglia rotations seed 1 is such a seed (r_y,
   // p = 0.001), and over seeds 1..300 each of the six tests rejected 2-4 times (calibrated).
   ASSERT_TRUE(r.status == 0 || r.status == 1) << r.out;
+  // Exit 1 must mean what it says: a decisive law rejected, named in the verdict line.
+  if (r.status == 1) {
+    EXPECT_NE(r.out.find("REJECTED"), std::string::npos) << r.out;
+  }
   EXPECT_NE(r.out.find("scene tiny"), std::string::npos) << r.out;
   const auto j = read_report(out / "tiny.json");
   EXPECT_EQ(j.at("scene"), "tiny");
