@@ -271,6 +271,58 @@ TEST(KsOneSample, StatisticByHand) {
   EXPECT_NEAR(ks_one_sample(y, [](double v) { return normal_cdf(v); }).D, 1.0 / 3.0, 1e-15);
 }
 
+// The pruned KS for expensive monotone cdfs returns ks_one_sample's D and p bit for bit: samples
+// from a mixture of asymmetric Laplace laws (the bounce residuals' shape) with ties, tested against
+// the true mixture, a 5 %-wrong scale (D large: few runs pruned), the mirrored law, a cdf flat over
+// most of the sample and a step, at n around the stride and up to 10^5. Under the true
+// law it must evaluate F far less often than n (the point of it).
+TEST(KsOneSample, MonotoneVariantIsTheSameTestWithFewerEvaluations) {
+  struct Part { double w, a1, a2; };
+  const std::vector<Part> mix = {{0.5, 1.0, 0.3}, {0.3, 2.0, 0.1}, {0.2, 0.5, 0.5}};
+  auto cdf_of = [&mix](double scale) {
+    return [&mix, scale](double x) {
+      double F = 0;
+      for (const auto& m : mix) {
+        const double a1 = scale * m.a1, a2 = scale * m.a2, t = a1 + a2;
+        F += m.w * (x < 0 ? a1 / t * std::exp(x / a1) : 1.0 - a2 / t * std::exp(-x / a2));
+      }
+      return std::clamp(F, 0.0, 1.0);
+    };
+  };
+  for (std::size_t n : {1u, 2u, 31u, 32u, 33u, 64u, 65u, 1000u, 100000u}) {
+    Stream s(5, Purpose::test, n);
+    std::vector<double> x(n);
+    for (auto& v : x) {
+      const double u = s.uniform();
+      const Part* m = &mix[0];
+      for (double c = mix[0].w; u > c && m != &mix.back(); c += (++m)->w) {}
+      const double e = -std::log(s.uniform());
+      v = s.uniform() < m->a1 / (m->a1 + m->a2) ? -m->a1 * e : m->a2 * e;
+      if (n > 1000 && v > 0 && v < 0.01) v = 0.005;  // ties
+    }
+    std::sort(x.begin(), x.end());
+    const auto flat = [](double v) { return v < -5 ? 0.0 : v > 5 ? 1.0 : 0.5; };
+    const auto right = cdf_of(1.0);
+    const auto mirrored = [&right](double v) { return 1.0 - right(-v); };
+    for (const Cdf& F : std::vector<Cdf>{right, cdf_of(1.05), mirrored, flat,
+                                         [](double v) { return v < 0 ? 1e-9 : 1.0; }}) {
+      std::size_t calls = 0;
+      const KsResult a = ks_one_sample(x, F);
+      const KsResult b = ks_one_sample_monotone(x, [&](double v) { ++calls; return F(v); });
+      EXPECT_EQ(a.D, b.D) << n;
+      EXPECT_EQ(a.p, b.p) << n;
+      EXPECT_EQ(a.n, b.n);
+      EXPECT_LE(calls, n);
+    }
+    std::size_t calls = 0;
+    const auto F = cdf_of(1.0);
+    ks_one_sample_monotone(x, [&](double v) { ++calls; return F(v); });
+    if (n == 100000) {
+      EXPECT_LT(calls, n / 8) << "the pruning must pay under the true law";
+    }
+  }
+}
+
 // Under H0 the p-values must be U(0,1). 2000 repetitions, n = 200 (the exact branch):
 //  - the number of p < 0.05 is Binomial(2000, 0.05): mean 100, sd 9.75; tolerance 4 sd (a
 //    correct p-value fails with probability 6e-5, while a p-value off by 20% fails reliably);
