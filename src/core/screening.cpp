@@ -14,6 +14,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include "asperity/core/random.hpp"
 
@@ -39,7 +40,13 @@ double cos_cover(const std::vector<Vec3>& u) {
     const P& pa = hull.point(hull.target(h));
     const P& pb = hull.point(hull.target(hull.next(h)));
     const P& pc = hull.point(hull.target(hull.next(hull.next(h))));
-    const Vec3 a(pa.x(), pa.y(), pa.z()), b(pb.x(), pb.y(), pb.z()), c(pc.x(), pc.y(), pc.z());
+    Vec3 a(pa.x(), pa.y(), pa.z()), b(pb.x(), pb.y(), pb.z()), c(pc.x(), pc.y(), pc.z());
+    // CGAL does not fix which vertex starts a face (two hulls of the same points differed), and
+    // the rounding of n depends on it: start at the lexicographically smallest vertex (a rotation,
+    // the orientation kept) so that the result is a function of the points alone.
+    const auto less = [](const Vec3& x, const Vec3& y) { return std::lexicographical_compare(x.data(), x.data() + 3, y.data(), y.data() + 3); };
+    if (less(b, a) && !less(c, b)) std::tie(a, b, c) = std::make_tuple(b, c, a);
+    else if (less(c, a) && less(c, b)) std::tie(a, b, c) = std::make_tuple(c, a, b);
     const Vec3 n = (b - a).cross(c - a);
     const double nn = n.norm();
     if (!(nn > 0)) return -1.0;
