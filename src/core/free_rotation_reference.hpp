@@ -39,7 +39,9 @@ inline RotationState reference_free_rotation(const Eigen::Matrix3d& J, const Rot
   namespace odeint = boost::numeric::odeint;
   // GCC 12 warns about odeint's own copy of an unused scratch array (a false positive in Boost).
 #pragma GCC diagnostic push
+#if defined(__GNUC__) && !defined(__clang__)  // clang has no such warning group
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
   const double tau = s * t;
   const double dt0 = tau > 0 ? 1e-3 : -1e-3;
   odeint::integrate_adaptive(odeint::make_controlled<odeint::runge_kutta_fehlberg78<State>>(tol, tol), rhs, y, 0.0,
