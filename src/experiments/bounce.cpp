@@ -213,7 +213,7 @@ void run_paper(std::uint64_t i, BounceVariant v, const BounceExperiment& b, cons
   for (std::uint32_t k = 1; k <= b.max_impacts; ++k) {
     if (u < b.stop_speed) break;
     sc.speed = u, sc.omega_x = wx;
-    const auto q = impact_law_parameters(sc);
+    const auto q = impact_law_parameters(sc, *p.eps_n);  // the run's Pade law: no allocation per impact
     const auto [g1, g2] = normal_pair(s);
     const double g3 = normal_pair(s).first;
     double eps = 0, wx_after = 0;
