@@ -101,6 +101,7 @@ LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere
                        BinomialModeCache* modes)
     : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)), modes_(modes) {
   check_asperity_count(n, "lazy sphere: asperities");
+  z_edges_.resize(kEdgeTable), phi_edges_.resize(kEdgeTable);
   reset(seed, sphere_id);
 }
 
@@ -125,12 +126,22 @@ void LazySphere::expand(std::size_t i) {
   if (width > dtheta) {
     const double pm = 0.5 * (c.p0 + c.p1);
     a.p1 = pm, b.p0 = pm;
-    a.c1 = b.c0 = std::cos(pm), a.s1 = b.s0 = std::sin(pm);
+    EdgePair e;
+    if (c.pk < kEdgeTable && !std::isnan(phi_edges_[c.pk].first)) e = phi_edges_[c.pk];
+    else e = {std::cos(pm), std::sin(pm)};
+    if (c.pk < kEdgeTable) phi_edges_[c.pk] = e;
+    a.c1 = b.c0 = e.first, a.s1 = b.s0 = e.second;
+    a.pk = 2 * c.pk, b.pk = 2 * c.pk + 1;
   } else {
     const double zm = 0.5 * (c.z0 + c.z1);
     a.z1 = zm, b.z0 = zm;
-    a.t1 = b.t0 = std::acos(std::clamp(zm, -1.0, 1.0));
-    a.r1 = b.r0 = rim(zm);
+    EdgePair e;
+    if (c.zk < kEdgeTable && !std::isnan(z_edges_[c.zk].first)) e = z_edges_[c.zk];
+    else e = {std::acos(std::clamp(zm, -1.0, 1.0)), rim(zm)};
+    if (c.zk < kEdgeTable) z_edges_[c.zk] = e;
+    a.t1 = b.t0 = e.first;
+    a.r1 = b.r0 = e.second;
+    a.zk = 2 * c.zk, b.zk = 2 * c.zk + 1;
   }
   a.id = 2 * c.id, b.id = 2 * c.id + 1;
   a.count = left, b.count = c.count - left;
@@ -213,6 +224,7 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
   q.psi = std::atan2(d.y(), d.x());
   q.cpsi = q.dxy > 0 ? d.x() / q.dxy : 1.0, q.spsi = q.dxy > 0 ? d.y() / q.dxy : 0.0;
   detail::TopTwo top;
+  std::size_t winner = 0;  // points_ index of top's first (no descent to its leaf afterwards)
   auto& h = heap_;
   h.clear();
   // Cells are visited in increasing (bound, cell index), as a heap of every open cell pops them;
@@ -239,7 +251,9 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
         // A centre not converted yet whose key cannot beat the runner-up would leave `top` as it
         // is (offer ignores keys above the second): it stays unconverted (no cos, sin, sqrt).
         if (std::isnan(points_[p].x()) && deferred_lower_key(points_[p], q) > top.second_key()) continue;
-        top.offer(static_cast<std::uint32_t>(c.offset + j), contact_key(centre(p), d));
+        const auto idx = static_cast<std::uint32_t>(c.offset + j);
+        top.offer(idx, contact_key(centre(p), d));
+        if (top.result().index == idx) winner = p;  // each centre is offered once per query
       }
       continue;
     }
@@ -262,14 +276,7 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
   }
   LazyNearest r;
   r.nearest = top.result();
-  // Find the winner's centre: it lies in a generated leaf (offset <= index < offset + count).
-  const std::uint64_t idx = r.nearest.index;
-  std::size_t i = 0;
-  while (!is_leaf(nodes_[i])) {
-    const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
-    i = idx < nodes_[ch + 1].offset ? ch : ch + 1;
-  }
-  r.u = centre(static_cast<std::size_t>(nodes_[i].points) + (idx - nodes_[i].offset));
+  r.u = points_[winner];  // converted when it was offered
   return r;
 }
 
