@@ -115,14 +115,22 @@ void LazySphere::reset(std::uint64_t seed, std::uint64_t sphere_id) {
 }
 
 void LazySphere::expand(std::size_t i) {
-  Node c = nodes_[i];
+  // The children are copied whole from the parent into nodes_ and their fields set there: built
+  // as locals and pushed, their field-by-field stores were read back as 16-byte moves, a store-
+  // forwarding stall per move.
+  const std::size_t first = nodes_.size();
+  nodes_[i].child = static_cast<std::int64_t>(first);
+  nodes_.push_back(nodes_[i]);
+  nodes_.push_back(nodes_[i]);
+  const Node& c = nodes_[i];
+  Node& a = nodes_[first];
+  Node& b = nodes_[first + 1];
   Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id);
   const std::uint64_t left = binomial_half(c.count, s, modes_);
   // Split the longer side (arc lengths) at its equal-area midpoint.
   const double dtheta = c.t0 - c.t1;  // acos(z0) - acos(z1)
   const double smax = std::max(c.r0, c.r1);
   const double width = (c.p1 - c.p0) * ((c.z0 <= 0 && c.z1 >= 0) ? 1.0 : smax);  // along the widest circle
-  Node a = c, b = c;
   if (width > dtheta) {
     const double pm = 0.5 * (c.p0 + c.p1);
     a.p1 = pm, b.p0 = pm;
@@ -147,9 +155,6 @@ void LazySphere::expand(std::size_t i) {
   a.count = left, b.count = c.count - left;
   a.offset = c.offset, b.offset = c.offset + left;
   a.child = b.child = a.points = b.points = -1;
-  nodes_[i].child = static_cast<std::int64_t>(nodes_.size());
-  nodes_.push_back(a);
-  nodes_.push_back(b);
 }
 
 void LazySphere::fill(std::size_t i) {
