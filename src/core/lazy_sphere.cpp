@@ -101,6 +101,7 @@ LazySphere::LazySphere(std::uint64_t n, std::uint64_t seed, std::uint64_t sphere
                        BinomialModeCache* modes)
     : n_(n), seed_(seed), sphere_(sphere_id), leaf_size_(std::max(1u, leaf_size)), modes_(modes) {
   check_asperity_count(n, "lazy sphere: asperities");
+  z_edges_.resize(kEdgeTable), phi_edges_.resize(kEdgeTable);
   reset(seed, sphere_id);
 }
 
@@ -114,31 +115,46 @@ void LazySphere::reset(std::uint64_t seed, std::uint64_t sphere_id) {
 }
 
 void LazySphere::expand(std::size_t i) {
-  Node c = nodes_[i];
+  // The children are copied whole from the parent into nodes_ and their fields set there: built
+  // as locals and pushed, their field-by-field stores were read back as 16-byte moves, a store-
+  // forwarding stall per move.
+  const std::size_t first = nodes_.size();
+  nodes_[i].child = static_cast<std::int64_t>(first);
+  nodes_.push_back(nodes_[i]);
+  nodes_.push_back(nodes_[i]);
+  const Node& c = nodes_[i];
+  Node& a = nodes_[first];
+  Node& b = nodes_[first + 1];
   Stream s(seed_, Purpose::lazy_sphere, sphere_, 2 * c.id);
   const std::uint64_t left = binomial_half(c.count, s, modes_);
   // Split the longer side (arc lengths) at its equal-area midpoint.
   const double dtheta = c.t0 - c.t1;  // acos(z0) - acos(z1)
   const double smax = std::max(c.r0, c.r1);
   const double width = (c.p1 - c.p0) * ((c.z0 <= 0 && c.z1 >= 0) ? 1.0 : smax);  // along the widest circle
-  Node a = c, b = c;
   if (width > dtheta) {
     const double pm = 0.5 * (c.p0 + c.p1);
     a.p1 = pm, b.p0 = pm;
-    a.c1 = b.c0 = std::cos(pm), a.s1 = b.s0 = std::sin(pm);
+    EdgePair e;
+    if (c.pk < kEdgeTable && !std::isnan(phi_edges_[c.pk].first)) e = phi_edges_[c.pk];
+    else e = {std::cos(pm), std::sin(pm)};
+    if (c.pk < kEdgeTable) phi_edges_[c.pk] = e;
+    a.c1 = b.c0 = e.first, a.s1 = b.s0 = e.second;
+    a.pk = 2 * c.pk, b.pk = 2 * c.pk + 1;
   } else {
     const double zm = 0.5 * (c.z0 + c.z1);
     a.z1 = zm, b.z0 = zm;
-    a.t1 = b.t0 = std::acos(std::clamp(zm, -1.0, 1.0));
-    a.r1 = b.r0 = rim(zm);
+    EdgePair e;
+    if (c.zk < kEdgeTable && !std::isnan(z_edges_[c.zk].first)) e = z_edges_[c.zk];
+    else e = {std::acos(std::clamp(zm, -1.0, 1.0)), rim(zm)};
+    if (c.zk < kEdgeTable) z_edges_[c.zk] = e;
+    a.t1 = b.t0 = e.first;
+    a.r1 = b.r0 = e.second;
+    a.zk = 2 * c.zk, b.zk = 2 * c.zk + 1;
   }
   a.id = 2 * c.id, b.id = 2 * c.id + 1;
   a.count = left, b.count = c.count - left;
   a.offset = c.offset, b.offset = c.offset + left;
   a.child = b.child = a.points = b.points = -1;
-  nodes_[i].child = static_cast<std::int64_t>(nodes_.size());
-  nodes_.push_back(a);
-  nodes_.push_back(b);
 }
 
 void LazySphere::fill(std::size_t i) {
@@ -213,6 +229,7 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
   q.psi = std::atan2(d.y(), d.x());
   q.cpsi = q.dxy > 0 ? d.x() / q.dxy : 1.0, q.spsi = q.dxy > 0 ? d.y() / q.dxy : 0.0;
   detail::TopTwo top;
+  std::size_t winner = 0;  // points_ index of top's first (no descent to its leaf afterwards)
   auto& h = heap_;
   h.clear();
   // Cells are visited in increasing (bound, cell index), as a heap of every open cell pops them;
@@ -239,37 +256,35 @@ LazyNearest LazySphere::lowest(const Vec3& d) {
         // A centre not converted yet whose key cannot beat the runner-up would leave `top` as it
         // is (offer ignores keys above the second): it stays unconverted (no cos, sin, sqrt).
         if (std::isnan(points_[p].x()) && deferred_lower_key(points_[p], q) > top.second_key()) continue;
-        top.offer(static_cast<std::uint32_t>(c.offset + j), contact_key(centre(p), d));
+        const auto idx = static_cast<std::uint32_t>(c.offset + j);
+        top.offer(idx, contact_key(centre(p), d));
+        if (top.result().index == idx) winner = p;  // each centre is offered once per query
       }
       continue;
     }
     if (nodes_[i].child < 0) expand(i);
     const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
-    Open kids[2];
+    // Bounds and cells of the kids as scalars: an array of pairs written field by field and read
+    // back whole stalled on store forwarding (the pushes were ~14 % of the query's time).
+    double kb[2];
+    std::size_t ki[2];
     int m = 0;
     for (std::size_t k = ch; k < ch + 2; ++k) {
       if (nodes_[k].count == 0) continue;
       const double lk = lower_key(nodes_[k], q);
       if (lk > top.second_key()) continue;
-      kids[m++] = {lk, k};
+      kb[m] = lk, ki[m] = k, ++m;
     }
-    if (m == 2 && kids[1] < kids[0]) std::swap(kids[0], kids[1]);
-    if (m == 2) h.push_back(kids[1]), std::push_heap(h.begin(), h.end(), cmp);
+    if (m == 2 && Open(kb[1], ki[1]) < Open(kb[0], ki[0])) std::swap(kb[0], kb[1]), std::swap(ki[0], ki[1]);
+    if (m == 2) h.emplace_back(kb[1], ki[1]), std::push_heap(h.begin(), h.end(), cmp);
     if (m >= 1) {
-      if (h.empty() || kids[0] < h.front()) cur = kids[0], in_hand = true;
-      else h.push_back(kids[0]), std::push_heap(h.begin(), h.end(), cmp);
+      if (h.empty() || Open(kb[0], ki[0]) < h.front()) cur = Open(kb[0], ki[0]), in_hand = true;
+      else h.emplace_back(kb[0], ki[0]), std::push_heap(h.begin(), h.end(), cmp);
     }
   }
   LazyNearest r;
   r.nearest = top.result();
-  // Find the winner's centre: it lies in a generated leaf (offset <= index < offset + count).
-  const std::uint64_t idx = r.nearest.index;
-  std::size_t i = 0;
-  while (!is_leaf(nodes_[i])) {
-    const std::size_t ch = static_cast<std::size_t>(nodes_[i].child);
-    i = idx < nodes_[ch + 1].offset ? ch : ch + 1;
-  }
-  r.u = centre(static_cast<std::size_t>(nodes_[i].points) + (idx - nodes_[i].offset));
+  r.u = points_[winner];  // converted when it was offered
   return r;
 }
 

@@ -213,7 +213,7 @@ void run_paper(std::uint64_t i, BounceVariant v, const BounceExperiment& b, cons
   for (std::uint32_t k = 1; k <= b.max_impacts; ++k) {
     if (u < b.stop_speed) break;
     sc.speed = u, sc.omega_x = wx;
-    const auto q = impact_law_parameters(sc);
+    const auto q = impact_law_parameters(sc, *p.eps_n);  // the run's Pade law: no allocation per impact
     const auto [g1, g2] = normal_pair(s);
     const double g3 = normal_pair(s).first;
     double eps = 0, wx_after = 0;
@@ -293,12 +293,15 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   // per possible count; above 2^24 centres the counts near the root are computed each time).
   std::unique_ptr<BinomialModeCache> modes;
   if (explicit_geometry) modes = std::make_unique<BinomialModeCache>(std::min<std::uint64_t>(sphere.asperities, 1u << 24));
+  // One lazy sphere per thread for the whole run (reset per sequence): its memory and its tables
+  // of edge functions (sphere-independent) carry over from block to block.
+  std::vector<std::unique_ptr<LazySphere>> spheres(static_cast<std::size_t>(std::max(1, nt)));
   for (std::uint64_t start = 0; start < b.sequences; start += chunk) {
     const std::int64_t m = static_cast<std::int64_t>(std::min(chunk, b.sequences - start));
 #pragma omp parallel num_threads(nt)
     {
-      std::unique_ptr<LazySphere> S;
-      if (explicit_geometry) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0, 8, modes.get());
+      auto& S = spheres[static_cast<std::size_t>(omp_get_thread_num())];
+      if (explicit_geometry && !S) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0, 8, modes.get());
 #pragma omp for schedule(dynamic, 8)
       for (std::int64_t j = 0; j < m; ++j) {
         auto& o = outs[static_cast<std::size_t>(j)];

@@ -3,6 +3,8 @@
 #include <omp.h>
 
 #include <Eigen/Dense>
+#include <boost/random/binomial_distribution.hpp>
+#include <boost/random/exponential_distribution.hpp>
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -143,29 +145,44 @@ bool ks_distance_reaches(std::span<const double> sorted, const AsymmetricLaplace
 }  // namespace
 
 namespace {
-// n draws of L, already sorted, in O(n) (no sort: the bootstrap's cost was the n log n sort): the
-// uniform order statistics are U_(i) = S_i/S_(n+1), S the partial sums of n + 1 standard exponentials
-// (Renyi), mapped through the quantile. Both tails are computed from their own side (S_i for the
-// lower, S_(n+1) - S_i as suffix sums for the upper), so no 1 - U cancels. `tail` is scratch (n + 1).
-void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::span<double> y, std::span<double> tail) {
-  const std::size_t n = y.size();
-  for (auto& e : y) e = -std::log(s.uniform());  // E_1 .. E_n (held in y until overwritten)
-  const double last = -std::log(s.uniform());    // E_(n+1)
-  tail[n] = last;                                // tail[i] = E_(i+1) + ... + E_(n+1)
-  for (std::size_t i = n; i-- > 0;) tail[i] = tail[i + 1] + y[i];
-  const double total = tail[0];
-  const double a = L.a(), c = L.c(), pl = c / (a + c);  // P(t < m)
-  double lower = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    lower += y[i];  // S_(i+1)
-    const double p = lower / total;
-    if (p < pl) y[i] = L.m + std::log(p / pl) / a;
-    else y[i] = L.m - std::log(tail[i + 1] / total / (1.0 - pl)) / c;  // q = tail / total only here
-  }
-  // Rounding in the two sums can break monotonicity by an ulp near the mode: restore it.
-  for (std::size_t i = 1; i < n; ++i) y[i] = std::max(y[i], y[i - 1]);
-}
+// A Stream as a Boost.Random engine: 64 random bits per call.
+struct StreamBits {
+  using result_type = std::uint64_t;
+  Stream* s;
+  static constexpr result_type min() { return 0; }
+  static constexpr result_type max() { return ~result_type{0}; }
+  result_type operator()() { return s->bits(); }
+};
+
 }  // namespace
+
+// Exact in law: K ~ Binomial(n, pl), pl = P(t < m), of the draws lie left of the mode, each
+// m - E/a, the other n - K at m + E/c, E ~ Exp(1) iid; the k exponentials of one side in ascending
+// order are Renyi's sums X_(j) = X_(j-1) + Z_j/(k - j + 1) of iid standard exponentials Z. The
+// inversion of n + 1 exponentials used before took two logarithms per value, the bootstrap's main
+// cost; here K comes from Boost's binomial (BTRD) and the Z from Boost's ziggurat (one 64-bit word
+// per draw but for ~1 % rejections, a logarithm only in its rare tail), Boost 1.74 as packaged
+// (tests pin a sample's values). The left side is written from the mode outwards. Sorted by
+// construction: X only grows and every rounded step is monotone; no 1 - U cancels (each side is a
+// sum from the mode).
+void sorted_sample(const AsymmetricLaplace& L, Stream& s, std::span<double> y) {
+  const double pl = L.c() / (L.a() + L.c());
+  StreamBits eng{&s};
+  const std::size_t n = y.size();
+  const auto k = static_cast<std::size_t>(boost::random::binomial_distribution<std::int64_t>(static_cast<std::int64_t>(n), pl)(eng));
+  const boost::random::exponential_distribution<double> E;
+  const double ia = 1.0 / L.a(), ic = 1.0 / L.c();
+  double x = 0;
+  for (std::size_t j = 0; j < k; ++j) {  // X_(j+1) of the k left draws: y[k - 1 - j]
+    x += E(eng) / static_cast<double>(k - j);
+    y[k - 1 - j] = L.m - x * ia;
+  }
+  x = 0;
+  for (std::size_t j = k; j < n; ++j) {
+    x += E(eng) / static_cast<double>(n - j);
+    y[j] = L.m + x * ic;
+  }
+}
 
 namespace {
 // The law fit_asymmetric_laplace_sorted finds for a bootstrap replicate (drawn sorted and finite,
@@ -210,9 +227,9 @@ namespace {
 // Only grows: a thread moves between tests of different n, and regrowing a vector would zero it
 // (the replicate writes every entry it reads).
 struct ReplicateScratch {
-  std::vector<double> y, tail, R, L;
+  std::vector<double> y, R, L;
   void fit(std::size_t n) {
-    if (y.size() < n) y.resize(n), tail.resize(n + 1), R.resize(n), L.resize(n);
+    if (y.size() < n) y.resize(n), R.resize(n), L.resize(n);
   }
 };
 
@@ -222,7 +239,7 @@ bool replicate_exceeds(const LaplaceFit& fit, double pl, double D, std::size_t n
   w.fit(n);
   const std::span<double> y(w.y.data(), n);
   Stream s(seed, Purpose::analysis, stream_index, static_cast<std::uint64_t>(b) + 1);
-  sorted_sample(fit.law, s, y, std::span<double>(w.tail.data(), n + 1));
+  sorted_sample(fit.law, s, y);
   AsymmetricLaplace law;
   return replicate_law(y, pl, std::span<double>(w.R.data(), n), std::span<double>(w.L.data(), n), law) &&
          ks_distance_reaches(y, law, D);

@@ -33,8 +33,10 @@ std::string num(double v, int prec = 6) {
   return os.str();
 }
 
-void require(bool ok, const std::string& what, double v) {
-  if (!ok) throw std::invalid_argument("ImpactScene: " + what + ", got " + num(v, 17));
+// `what` as a C string: a std::string parameter built one string per check, and the paper's bounce
+// procedure validates a scene per impact.
+void require(bool ok, const char* what, double v) {
+  if (!ok) throw std::invalid_argument(std::string("ImpactScene: ") + what + ", got " + num(v, 17));
 }
 
 // Standard normal cdf and density of N(0, s^2) at y.
@@ -128,21 +130,25 @@ struct Setup {
   Core core;
 };
 
-Setup setup(const ImpactScene& s) {
+// `eps_n`: viscoelastic_pade14(s.beta) built by the caller (impact_law_parameters' overload), or
+// null for one built here.
+Setup setup(const ImpactScene& s, const Restitution* eps_n = nullptr) {
   validate(s);
   Setup x;
   x.s = s;
   x.u = s.speed, x.R = s.radius, x.a = s.asperity_radius;
   x.omega = std::hypot(s.omega_x, s.omega_y);
   auto& p = x.p;
-  const auto en = viscoelastic_pade14(s.beta);
+  std::unique_ptr<Restitution> own;
+  if (!eps_n) own = viscoelastic_pade14(s.beta), eps_n = own.get();
+  const Restitution& en = *eps_n;
   p.lambda = areal_density(s.asperities, x.R);
   p.sigma = 1.0 / std::sqrt(2.0 * pi * p.lambda);
   p.inertia = 0.4 * (s.literal_eq23 ? x.a * x.a : x.R * x.R);
   const double rz = x.R + x.a;
   p.c2 = p.inertia + rz * rz;
-  p.eps_n = (*en)(x.u);
-  p.eps_n_prime = derivative(*en, x.u);
+  p.eps_n = en(x.u);
+  p.eps_n_prime = derivative(en, x.u);
   p.alpha = (1.0 + p.eps_n) / p.c2;
   p.b = x.omega * ((1.0 + p.eps_n) / x.u + p.eps_n_prime);
   p.shift = p.b / (2.0 * p.alpha);
@@ -428,6 +434,8 @@ void validate(const ImpactScene& s) {
 }
 
 ImpactLawParameters impact_law_parameters(const ImpactScene& s) { return setup(s).p; }
+
+ImpactLawParameters impact_law_parameters(const ImpactScene& s, const Restitution& eps_n) { return setup(s, &eps_n).p; }
 
 // =====================================================================================
 Law eq28_corrected(const ImpactScene& s, double alpha_scale) {

@@ -14,6 +14,7 @@
 #include <boost/math/quadrature/gauss.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
@@ -192,6 +193,27 @@ TEST(TheoryImpact, NumbersAtTheFigureParameters) {
   EXPECT_THROW(eq28_corrected([] { auto s = fig4(); s.speed = 0; return s; }()), std::invalid_argument);
   EXPECT_THROW(eq33_corrected([] { auto s = fig4(); s.asperity_radius = 4e-3; return s; }()), std::invalid_argument);
   EXPECT_THROW(eq28_printed([] { auto s = fig4(); s.omega_x = NAN; return s; }()), std::invalid_argument);
+}
+
+// The overload with the caller's Pade law (the paper's bounce procedure, once per impact) gives
+// every field bit for bit, at speeds and spins the bounces visit; a different law (another beta)
+// must not.
+TEST(TheoryImpact, ParametersWithTheCallersPadeAreTheSame) {
+  auto s = fig4();
+  const auto en = viscoelastic_pade14(s.beta);
+  const auto other = viscoelastic_pade14(2.0 * s.beta);
+  auto fields = [](const ImpactLawParameters& p) {
+    return std::vector<double>{p.lambda, p.sigma, p.inertia, p.c2, p.eps_n, p.eps_n_prime, p.alpha, p.b,
+                               p.shift, p.noncentrality, p.eps_max, p.sigma_c, p.sigma_printed, p.r_star, p.p_core};
+  };
+  for (double u : {1.3, 0.71, 0.2, 0.013}) {
+    for (double w : {0.0, -3.7, 12.5}) {
+      s.speed = u, s.omega_x = w;
+      const auto a = fields(impact_law_parameters(s)), b = fields(impact_law_parameters(s, *en));
+      for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(std::bit_cast<std::uint64_t>(a[i]), std::bit_cast<std::uint64_t>(b[i])) << i;
+      EXPECT_NE(fields(impact_law_parameters(s, *other))[4], a[4]);
+    }
+  }
 }
 
 TEST(TheoryImpact, CorrectedLawsAreNormalisedDensities) {

@@ -91,7 +91,18 @@ class LazySphere {
     std::uint64_t offset;  // global index of its first centre
     std::int64_t child = -1;   // index of the first child in nodes_ (second = child + 1)
     std::int64_t points = -1;  // leaves: index of the first centre in points_
+    // The cell's z and phi intervals in the trees of z and of phi halvings (root 1, halves 2 k
+    // and 2 k + 1): an edge's value, and so its acos, sqrt, cos, sin, depends on nothing else.
+    std::uint64_t zk = 1, pk = 1;
   };
+  // acos and sqrt(1 - z^2) of the midpoint of z interval k, cos and sin of that of phi interval
+  // k, for k < kEdgeTable: computed on first use and kept across reset() (the same values for
+  // every sphere), so the splits of later spheres take no acos, sqrt, sin or cos.
+  static constexpr std::uint64_t kEdgeTable = std::uint64_t{1} << 15;
+  struct EdgePair {
+    double first = std::numeric_limits<double>::quiet_NaN(), second = 0;
+  };
+  std::vector<EdgePair> z_edges_, phi_edges_;
   bool is_leaf(const Node& c) const { return c.count <= leaf_size_ || c.id >= (std::uint64_t{1} << 60); }
   void expand(std::size_t i);
   void fill(std::size_t i);

@@ -51,6 +51,11 @@ struct AsymmetricLaplace {
   double sample(Stream& s) const;
 };
 
+/// y.size() iid draws of `law`, sorted ascending, in O(n) without a logarithm per value: the
+/// bootstrap's replicate sample (the count left of the mode from a binomial, each side's
+/// exponential order statistics as Renyi sums of ziggurat exponentials; laplace.cpp says more).
+void sorted_sample(const AsymmetricLaplace& law, Stream& s, std::span<double> y);
+
 struct LaplaceFit {
   AsymmetricLaplace law;
   std::size_t n = 0;

@@ -90,6 +90,10 @@ struct ImpactLawParameters {
   double p_core = 0;     ///< exp(-r*^2/(2 sigma^2)): probability of a core contact (flat cap)
 };
 ImpactLawParameters impact_law_parameters(const ImpactScene& s);
+/// The same with eps_n from `eps_n`, which must be viscoelastic_pade14(s.beta) (the same values bit
+/// for bit): for callers that evaluate many speeds of one scene (the paper's bounce procedure,
+/// once per impact), without building the Pade law each time.
+ImpactLawParameters impact_law_parameters(const ImpactScene& s, const Restitution& eps_n);
 
 /// The map of eq28_paper_route for generative use: eps at r_xy = s [m], impact speed u [m/s] and
 /// spin Omega_x [rad/s] (paper frame, as given), with eps_n and c^2 from `p` (the scene at speed u):
