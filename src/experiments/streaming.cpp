@@ -44,12 +44,10 @@ struct Slot {
 // What the threads of a wave write into: fine counts into their own histograms (folded into the
 // state at checkpoints and at the end), coarse counts of their current block into their own cells
 // (added atomically -- integers: any order -- when the block changes and at fold()), moments into
-// their slot. So a drop costs no atomic operation and no transcendental function. A drop's three
-// fine increments go into 16-bit counters (3 x 2^16 x 2 bytes per thread: beside the index in a
-// 1 MiB L2, where 64-bit counters, 1.5 MiB, pushed the index's records out), moved into the
-// thread's 64-bit histograms before any counter can reach 2^16 (spill); they are made kLag drops
-// later, after a prefetch of their lines (integer counts: the order does not matter). Whoever
-// counts on thread t calls drain(t) before its counts are read.
+// their slot. So a drop costs no atomic operation and no transcendental function. The fine
+// histograms (3 x 2^16 x 8 bytes per thread) do not fit in L2 with the index: a drop's three
+// increments are made kLag drops later, after a prefetch of their lines (integer counts: the
+// order does not matter). Whoever counts on thread t calls drain(t) before its counts are read.
 struct Sink {
   static constexpr std::size_t kNoBlock = ~std::size_t{0};
   static constexpr std::size_t kLag = 16;
@@ -60,11 +58,6 @@ struct Sink {
   std::vector<BinnedStats>& stats;
   std::vector<const FineBinner*> bin;            // per quantity
   std::vector<std::vector<std::uint64_t>> fine;  // thread t, quantity q at t * kQ + q
-  std::vector<std::vector<std::uint16_t>> fine16;  // the same, counted since the last spill
-  // Drops counted by thread t since its last spill: every 16-bit counter is <= this + kLag (the
-  // increments staged before the spill land after it), so spilling at kSpill never overflows.
-  static constexpr std::size_t kSpill = 65535 - kLag;
-  std::vector<std::size_t> since_spill;
   std::vector<std::vector<std::uint64_t>> cell;  // thread t: quantity q's coarse bin c at q C + c
   std::vector<std::size_t> cell_block;           // thread t: the block its cells count, or kNoBlock
   std::vector<Pending> pending;                  // thread t: fine bins not yet counted
@@ -74,7 +67,6 @@ struct Sink {
 
   Sink(std::vector<BinnedStats>& s, std::vector<const FineBinner*> b, std::size_t threads, std::uint64_t spheres)
       : stats(s), bin(std::move(b)), fine(threads * kQ, std::vector<std::uint64_t>(s[0].fine_bins(), 0)),
-        fine16(threads * kQ, std::vector<std::uint16_t>(s[0].fine_bins(), 0)), since_spill(threads, 0),
         cell(threads, std::vector<std::uint64_t>(kQ * s[0].coarse_bins(), 0)), cell_block(threads, kNoBlock),
         pending(threads), K(spheres), G(s[0].blocks) {
     for (std::size_t q = 0; q < kQ; ++q) ref_mean[q] = s[q].ref.mean();
@@ -83,7 +75,6 @@ struct Sink {
   void count(int t, std::size_t g, const Contact& ct, Slot& slot) {
     const auto ti = static_cast<std::size_t>(t);
     if (cell_block[ti] != g) flush(ti), cell_block[ti] = g;
-    if (++since_spill[ti] > kSpill) spill(ti), since_spill[ti] = 1;
     std::uint64_t* cells = cell[ti].data();
     const unsigned shift = stats[0].fine_log2 - stats[0].coarse_log2;
     const std::size_t C = stats[0].coarse_bins();
@@ -92,7 +83,7 @@ struct Sink {
     std::uint32_t* staged = p.f[p.n % kLag];
     for (std::size_t q = 0; q < kQ; ++q) {
       const std::size_t f = (*bin[q])(x[q]);
-      std::uint16_t* h = fine16[ti * kQ + q].data();
+      std::uint64_t* h = fine[ti * kQ + q].data();
       if (p.n >= kLag) ++h[staged[q]];
       staged[q] = static_cast<std::uint32_t>(f);
       __builtin_prefetch(h + f, 1);
@@ -106,18 +97,8 @@ struct Sink {
     const auto ti = static_cast<std::size_t>(t);
     Pending& p = pending[ti];
     for (std::size_t i = 0; i < std::min(p.n, kLag); ++i)
-      for (std::size_t q = 0; q < kQ; ++q) ++fine16[ti * kQ + q][p.f[i][q]];
+      for (std::size_t q = 0; q < kQ; ++q) ++fine[ti * kQ + q][p.f[i][q]];
     p.n = 0;
-  }
-  // Thread t's 16-bit counts into its 64-bit histograms (every 65519 drops: ~3 additions per drop).
-  void spill(std::size_t t) {
-    for (std::size_t q = 0; q < kQ; ++q) {
-      std::uint64_t* dst = fine[t * kQ + q].data();
-      std::uint16_t* src = fine16[t * kQ + q].data();
-      for (std::size_t b = 0, n = fine16[t * kQ + q].size(); b < n; ++b) dst[b] += src[b];
-      std::fill_n(src, fine16[t * kQ + q].size(), std::uint16_t{0});
-    }
-    since_spill[t] = 0;
   }
   void flush(std::size_t t) {
     const std::size_t g = cell_block[t], C = stats[0].coarse_bins();
@@ -131,7 +112,7 @@ struct Sink {
     cell_block[t] = kNoBlock;
   }
   void fold() {
-    for (std::size_t t = 0; t < cell.size(); ++t) flush(t), spill(t);
+    for (std::size_t t = 0; t < cell.size(); ++t) flush(t);
     for (std::size_t i = 0; i < fine.size(); ++i) {
       auto& dst = stats[i % kQ].fine;
       for (std::size_t b = 0; b < dst.size(); ++b) dst[b] += fine[i][b];
@@ -386,9 +367,7 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
   st.index_bytes = std::max<std::uint64_t>(st.index_bytes, dr.bytes);
   out.index_bytes = static_cast<std::size_t>(st.index_bytes);
   out.cross_check.queries = st.check_queries, out.cross_check.agreed = st.check_agreed;
-  for (const auto& s : st.stats)
-    out.memory_bytes += (s.fine.size() * (1 + threads) + s.coarse.size() + threads * s.coarse_bins()) * 8 +
-                        s.fine.size() * threads * sizeof(std::uint16_t);
+  for (const auto& s : st.stats) out.memory_bytes += (s.fine.size() * (1 + threads) + s.coarse.size() + threads * s.coarse_bins()) * 8;
   for (const auto& b : binners.distinct) out.memory_bytes += b.memory_bytes();
   return out;
 }
