@@ -102,8 +102,7 @@ TEST(Stress, ExplicitSphereLowestIsTheTrueOne) {
     const auto body = make_rough_sphere({N, 3e-3, 3e-3 * 1e-9}, 11, 0);
     const auto grid = make_contact_query(Backend::grid, body.centres);
     const auto tree = make_contact_query(Backend::kdtree, body.centres);
-    // 40 rotations per sphere in Release, 10 under the sanitizers (16 s there, mostly the test's
-    // own long-double scans of 10^6 centres at -O0).
+    // 40 rotations per sphere in Release, 10 under the sanitizers (the test took 16 s there).
     const int rotations = asperity::testing::kSanitized ? 10 : 40;
     int checked = 0;
     for (std::uint64_t j = 0; j < static_cast<std::uint64_t>(rotations); ++j) {
@@ -468,7 +467,7 @@ TEST(StressCli, OutOfRangeValuesAreCleanErrors) {
                                 "--speed 1e8 --omega-x 3e10 --drops 100", "--speed 1e-12 --drops 100"}) {
     const fs::path out = scratch("edge");
     // Under the sanitizers the edges run on spheres of 10^3 asperities where the case does not set
-    // N (the default 10^6-asperity explicit sphere per run made this test 35 s there).
+    // N (with the default scene's explicit spheres of 10^5 the test took 35 s there, now 13 s).
     const bool small = asperity::testing::kSanitized && ok.find("--asperities") == std::string::npos;
     const CliResult r = run_cli(ok + (small ? " --asperities 1000" : "") + " --out " + out.string());
     EXPECT_TRUE(r.status == 0 || r.status == 1) << ok << "\n" << r.out;

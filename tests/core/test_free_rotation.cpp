@@ -80,8 +80,8 @@ constexpr double kRefTol = 1e-10;
 }  // namespace
 
 TEST(FreeRotation, MatchesOdeintReferenceForRandomBodies) {
-  // 150 bodies in Release; 30 under the sanitizers, where the Odeint reference (this file, built at
-  // -O0 there) took 34 s: the memory checks see the same code paths on fewer bodies.
+  // 150 bodies in Release; 30 under the sanitizers, where the test took 34 s (its Odeint reference
+  // is test code, built at -O0 there): the memory checks see the same code paths on fewer bodies.
   const std::uint64_t bodies = asperity::testing::kSanitized ? 30 : 150;
   double worst = 0;
   for (std::uint64_t i = 0; i < bodies; ++i) {

@@ -79,8 +79,9 @@ KsResult ks_one_sample(std::span<const double> sorted, const Cdf& cdf);
 /// The same D and p as ks_one_sample, bit for bit, for a cdf that is expensive and
 /// non-decreasing (a mixture of many laws): F is evaluated at every 32nd point first, and a run of
 /// points between two evaluated ones only when the bounds F(lo) <= F <= F(hi) leave room for it to
-/// reach the largest distance found (with a margin of 1e-12 for rounding in F). Typically n/16
-/// evaluations instead of n. Only evaluated values are checked to lie in [0, 1].
+/// reach the largest distance found (with a margin of 1e-12 for rounding in F). Measured under a
+/// true law: n/23 evaluations at n = 1e5, n/31 at 1.9e6, but n/1.2 at 1e3 (the runs are too short
+/// for their bounds to fall below D). Only evaluated values are checked to lie in [0, 1].
 KsResult ks_one_sample_monotone(std::span<const double> sorted, const Cdf& cdf);
 /// Two-sample KS test; both inputs sorted ascending (checked) and non-empty. D is exact
 /// (ties within and between the samples are handled: both ECDFs step past a value before
