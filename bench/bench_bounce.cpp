@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bounce sequences per second for each variant of Sec. V (bounce.hpp), and what one explicit
 // sphere would cost instead of the lazy one. Prints markdown for bench/RESULTS.md.
 //   bench_bounce [--sequences S] [--repeats R] [--threads T] [--quick]

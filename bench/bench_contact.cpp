@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // bench_contact: the contact-backend benchmark of the issue "per backend and N: build time,
 // queries/s with 1 and 2 threads, bytes per asperity, fresh drops/s; brute force, kd-tree and FCL as
 // baselines in the same run, as ratios". A plain std::chrono driver that prints markdown tables of

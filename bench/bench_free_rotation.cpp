@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // ns per FreeRotation::at(t) (closed form) against the Odeint reference (integrating Euler's
 // equations from 0 to t on every call, src/free_rotation_reference.hpp), for t spread over
 // 0..10 periods; the counter max_err is each method's largest difference from the other over

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Micro benchmarks of the grid contact backend against the nanoflann kd-tree: build time, single
 // queries and batched queries on uniformly random directions. Run single-threaded for per-core
 // numbers: OMP_NUM_THREADS=1 ./bench_grid

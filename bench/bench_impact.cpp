@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Impulse solves per second: the general 3x3 LDLT solve against the closed form, on the contacts
 // of Fig. 4 (random r from fresh caps, u = 1.3 m/s, Omega = (0.2, 0, 0) rad/s, Pade eps_n).
 #include <benchmark/benchmark.h>

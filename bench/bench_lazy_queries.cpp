@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Lazy-sphere queries in random-orientation's pattern (bench/RESULTS.md "fig6, fourth pass"): per
 // sequence a fresh sphere of N = 1e6 (reset), then 55 queries for Haar-random down directions,
 // one thread. Prints the thread's CPU time and a checksum of the answers (equal across builds

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Micro-benchmarks (Google Benchmark) of every stage of a drop, N = 10^3 ... 10^7:
 //   - sphere generation (make_rough_sphere) with 1 and 2 OpenMP threads;
 //   - each contact backend's build, with its index memory and the PEAK resident memory of the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // bench_scenes: what the planner saves. A plain std::chrono driver printing markdown (the text of
 // bench/RESULTS.md "Planner").
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Throughput of the streaming explicit path (issue 14, item 3): explicit drops per second at
 // N = 10^4 (sphere generation, index, queries, cross-check and streaming statistics all counted:
 // the wall time of run_contact_stream), per backend, with the raw-sample path (grid) as a ratio in

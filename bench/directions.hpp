@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Query-direction streams shared by the benchmarks: uniformly random directions, and the path of a
 // slowly turning body. Both are pure functions of (count, seed, step), so every benchmark times the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The quenched deviation of one explicit sphere's law of r_xy from the ensemble law (kQuenchedKs,
 // experiments/ensemble.hpp; README "The explicit design"; bench/RESULTS.md). K explicit spheres of
 // N asperities (grid query), M Haar-random rotations each, against the exact finite-N law F:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Driver for the experiments beyond the paper (body_experiments.hpp): unequal asperity radii on a
 // sphere, rough mesh bodies, and PLY export. Exit status 2 with a clear message on bad input.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Run time against error: for each sampling strategy, grow the number of samples n over a
 // geometric ladder and record the wall time of the whole pipeline (sphere generation, index
 // build, queries) and the error of the r_xy sample against the EXACT finite-N law

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Refuses an include edge that runs upwards through the layers core <- laws <- experiments <- app:
 # every #include "asperity/<layer>/..." or "<layer>/..." (private src/ headers) in
 # include/asperity/<layer>/ and src/<layer>/ must name the same layer or one below (src/python/ is app).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # cmake -DDIR=<scenes dir> -DNAMES=<a,b,...> -DOUT=<header> -P embed_scenes.cmake
 # Embeds the preset scene files DIR/NAME.toml as byte arrays, so that the library (and an
 # installed validate-geometry) needs no source tree to run a preset.

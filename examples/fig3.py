@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Fig. 3 of the paper from explicit geometry: r_xy of the lowest asperity against Eq. 14 and the
 exact finite-N law. 20 explicit rough spheres (N = 1e5) x 10^4 random orientations; writes fig3.png.
 Run: PYTHONPATH=build/python python3 examples/fig3.py   (a few seconds)"""

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Writes the base bodies of meshes/ as closed, outward-oriented triangle meshes (OFF, metres).
 
   icosphere.off     sphere R = 3 mm, icosahedron subdivided 3 times (1280 faces)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // report.json without what may differ between runs that must agree (a split, an interrupted and
 // resumed, and a whole run): wall-clock timings, the plan's stage seconds, the echoed scene file.

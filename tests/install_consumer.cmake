@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Installs the built project into a temporary prefix, then configures, builds and runs
 # tests/consumer against it with find_package(asperity CONFIG REQUIRED), linking asperity::${TARGET}.
 file(REMOVE_RECURSE "${WORK_DIR}")

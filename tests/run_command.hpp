@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Runs a shell command as a user would and captures what it prints (stdout + stderr when the
 // command redirects 2>&1) and its exit status (-1 if it did not exit normally, e.g. a crash).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // ASPERITY_SANITIZED: this test binary is built with AddressSanitizer or ThreadSanitizer (gcc or
 // clang). Tests whose point is a rate or a power over many repetitions assert it in the Release

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 # scripts/run then scripts/test, in the order a newcomer runs them (issue 16 item 15): scripts/run
 # configures build/release with the tests off, and the cache keeps options. The test command
 # must turn every test on whatever was configured before, and ctest must fail when it finds none.

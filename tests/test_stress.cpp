@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Numerical stability at the extremes (ctest label `stress`): every parameter pushed to the edge
 // of its supported range gives a finite, correct answer or a clear error, never NaN, a wrong
 // asperity or a crash. References are computed in long double (x87, 64-bit mantissa), 11 bits

@@ -1,3 +1,8 @@
+/* SPDX-License-Identifier: MIT */
+/* Copyright (c) 2026 the asperity developers. This header, and the table format it reads, are
+ * MIT-licensed (the text is in LICENSE): unlike the rest of asperity (GPL-3.0-or-later), a DEM code
+ * under any licence (GPL-2.0-only LAMMPS/LIGGGHTS, BSD) may include it. It depends on nothing but
+ * the C standard library, so including it brings in no GPL code. */
 /* asperity restitution tables for DEM codes: one self-contained C99 header, no dependencies beyond
  * the C standard library (README "Restitution tables"). Works from C and C++.
  *

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tables and report.json bodies of the experiments beyond the paper (radii, mesh impacts).
 #include "asperity/app/experiment_reports.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tables, report.json bodies and gnuplot figures of bounce runs (spheres and mesh bodies).
 #include "asperity/app/experiment_reports.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The only CGAL mesh headers of the project: reading and checking triangle meshes.
 #include "asperity/app/mesh_io.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Histogram-vs-theory figures drawn by gnuplot (pngcairo). The script and its inline data go to a
 // private temporary directory, gnuplot renders to a temporary file beside the target, and the
 // result is renamed onto the target only when gnuplot succeeded: a failure never leaves a partial

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Scene files (format 1). toml++ is used header-only, in this translation unit only.
 #include "asperity/app/scene_file.hpp"
 

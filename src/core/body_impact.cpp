@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/core/body_impact.hpp"
 
 namespace asperity {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Numbers in error messages: the shortest text that reads back to the same double, so the
 // offending value is named exactly and as the user would write it (1e+200, not 9.99...97e+199).

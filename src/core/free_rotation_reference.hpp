@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The test and benchmark reference for FreeRotation: Euler's equations J_b w' = (J_b w) x w for the
 // body-frame angular velocity w plus the quaternion kinematics q' = q (0, w) / 2, integrated by

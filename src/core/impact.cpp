@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/core/impact.hpp"
 
 #include <Eigen/Cholesky>

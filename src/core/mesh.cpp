@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Mesh bodies: mass properties, area-uniform asperity tiling, smooth surfaces. Reading and
 // writing mesh files is app/mesh_io.cpp (CGAL's I/O stays out of the core).
 #include "asperity/core/mesh.hpp"

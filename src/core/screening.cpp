@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Screening of unequal asperities on a rough sphere: exact local tests (see screening.hpp).
 #include "asperity/core/screening.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Exact support queries over asperity balls: brute force and a bounding-volume hierarchy.
 #include "asperity/core/support.hpp"
 

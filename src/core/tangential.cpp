@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tangential contact laws (tangential.hpp; derivations in docs/tangential-laws.md).
 //
 // The impulse process works in the contact frame B = (t1, t2, n): the contact velocity is

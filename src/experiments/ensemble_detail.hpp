@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Shared by the two explicit drivers (ensemble.cpp: raw samples; streaming.cpp: streaming
 // statistics): which queries are answered again by other backends, and the re-answering.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Internal pieces shared by the laws of theory.cpp (equal radii) and theory_radii.cpp (level
 // radii). Include after <cmath> with `using std::isnan;` visible (Boost 1.74's pchip calls isnan

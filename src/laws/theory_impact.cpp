@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Sec. IV laws: eps (Eq. 28) and Omega'_x (Eq. 33), as printed and as corrected. Derivations and
 // the error budget of every approximation: docs/sec4-derivations.md.
 #include "asperity/laws/theory_impact.hpp"

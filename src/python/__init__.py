@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """asperity: explicit-geometry contacts and restitution statistics of rough particles.
 
 Thin bindings of the C++ library (README "Python"): asperity.run(scene) runs a scene as the CLI

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The Python module asperity._asperity (README "Python"): thin bindings of the C++ library, one
 // translation unit. No physics here: every number comes from the library; this file converts
 // arguments (numpy arrays, dicts, callables) and results, releases the GIL while the library

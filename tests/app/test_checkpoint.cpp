@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Long streaming runs survive (issue 14, item 4): SIGTERM ends a run with a checkpoint, `--resume
 // DIR` continues it to a report identical to the uninterrupted run's (timings aside), a checkpoint
 // is never overwritten by a new run, and a damaged or foreign checkpoint is refused.

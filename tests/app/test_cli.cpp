@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // validate-geometry as a user meets it: every bad input is a clear error naming the value with
 // exit status 2 and no files left behind; a good run writes a report.json that honours the schema.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // validate-geometry against a hostile user (issue 16): a run never loses a user's files, never
 // crashes, and refuses up front what cannot run. Output: all or nothing, on failure and on any
 // signal; messages carry the system's reason.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Restitution tables (app/cor_table.hpp): quantiles per speed, validation, and the CSV read back by
 // the C header a DEM code uses (include/asperity/cor_table.h, C99, compiled here as C++).
 #include <gtest/gtest.h>

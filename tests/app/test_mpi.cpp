@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Beyond one machine (issue 14, item 5): `mpirun -np 2 validate-geometry ...` splits a streaming run
 // across processes and writes the report of one process (timings aside); SIGTERM ends every process
 // with its checkpoint, and `mpirun -np 2 validate-geometry --resume DIR` continues to the same report.

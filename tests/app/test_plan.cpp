@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The planner runs only what a scene's outputs need: no impact stage for contact statistics, no
 // sphere or index in fresh mode, a scan instead of an index for few rotations per sphere, no law
 // that was not asked for -- and skipping a stage never changes a result that is reported.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // write_histogram_png: a Gaussian histogram against its pdf renders to a real PNG; failures throw
 // and leave nothing behind; invalid figures are rejected before gnuplot runs.
 #include "asperity/app/plot.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Memory refused up front (issue 16 item 11): estimate_memory against the peak RSS that
 // validate-geometry really reaches, within 25 %, for each kind of cost (per asperity of an index,
 // per concurrently built sphere, per drop, per mesh body, per bounce sequence); runs that do not

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // run_scene_output: every kind of scene through one report path, with progress of the drops.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Scene files: the presets as files reproduce the presets as they were written in C++, every bad
 // key or value is an error naming the key, unsupported features are refused, and to_toml
 // round-trips.

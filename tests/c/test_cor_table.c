@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: GPL-3.0-or-later */
 /* A DEM code's view of a restitution table: this file is built against include/asperity/cor_table.h
  * alone (C99, no asperity library linked). Without arguments it checks the sampler on a small table
  * written here; with a path it also loads that table (one asperity wrote) and checks its shape. */

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // A downstream DEM contact model: finds the touching asperity and resolves the impulse using only
 // core headers (asperity/core/...), so it builds against asperity::core alone.
 #include <asperity/core/contact.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The contract of every contact backend: the same answer as the brute-force reference, bit for
 // bit (index, key, runner-up, runner-up key), on random and adversarial queries.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The cube-map grid backend must agree bit-for-bit with brute_lowest on every query.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The CGAL kd-tree and FCL AABB-tree backends agree bit-for-bit with the reference scan,
 // including on adversarial ties, and answer concurrent queries exactly as serial ones.
 #include <gtest/gtest.h>

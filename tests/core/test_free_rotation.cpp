@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // FreeRotation: torque-free motion of an asymmetric rigid body. The closed form is checked against
 // an independent Odeint integration of Euler's equations (src/free_rotation_reference.hpp), against
 // the closed forms of its degenerate cases, and against the symmetries of the motion.

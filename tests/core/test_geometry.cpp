@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Rough spheres and orientations: determinism, uniformity, and that a biased sampler is caught.
 #include <gtest/gtest.h>
 

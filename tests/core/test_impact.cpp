@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The impulse solve (paper Eqs. 3-7) and the restitution models: the closed form against the
 // general 3x3 solve, physical invariants, and the sign of Delta Omega pinned on fixed vectors.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The lazy exact sphere: same centres and same answers as an explicit sphere, exactly N centres,
 // uniform, and an exact binomial sampler.
 #include <gtest/gtest.h>

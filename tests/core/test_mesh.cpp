@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Mesh bodies: reading and checks, mass properties against exact and analytic values, area-uniform
 // tiling, the exact support query on flat faces, impacts with the full inertia tensor, PLY export.
 #include <gtest/gtest.h>

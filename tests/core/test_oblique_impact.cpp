@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Oblique impact of a sphere on a flat anvil (issue 18 item 3): every tangential law against its
 // closed form, and solve_impact at the inputs of Kharaz, Gorham & Salman (2001) -- the 5 mm Al2O3
 // sphere on soda-lime glass, v = 3.9 m/s, e_n = 0.98, mu = 0.092, also test 4 of Chung & Ooi's DEM

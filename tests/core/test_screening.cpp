@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Screening of unequal asperities: every asperity that can touch is kept, the screened ones
 // never touch (checked by dense direction sampling), equal radii screen nothing.
 #include <gtest/gtest.h>

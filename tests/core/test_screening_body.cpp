@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Screening of general (mesh) rough bodies, screen_body: agrees with screen_sphere on spheres,
 // keeps everything with equal radii on a strictly convex body, never screens a winner of random or
 // local directions with level radii, and the same cross-check rejects an unsound variant.

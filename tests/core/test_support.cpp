@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The exact support query with unequal radii: the tree returns bit-for-bit what the brute-force
 // scan returns, on random, tied and nearly tied directions.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tangential contact laws (tangential.hpp): limits against the simpler laws and closed forms,
 // the work-energy identity of the impulse process, conservation of angular momentum about the
 // contact point, the restitution rules, and the energy invariant that separates Stronge's law from

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bounce sequences of general rough bodies: energy in flight and at impacts, the landing search
 // against a brute dense scan (and a too-optimistic bound that must miss contacts), the rough
 // sphere's first impacts against the corrected Eq. 28, thread-count independence.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Bounce sequences of Sec. V: free flight and rotation, reproducibility, the physics of the first
 // impact, and validate-geometry --preset fig6 end to end.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Ensembles of drops against the laws. The explicit design (K explicit spheres x M rotations,
 // contacts by spatial query) is the default; its decisive tests use every drop with a null that
 // accounts for the spread between spheres (sphere-block bootstrap). Every statistical test here

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The finite-N correction of Eq. 14 seen from explicit geometry (issue 14, item 2): at N = 10^3,
 // 2 x 10^6 explicit drops (5000 spheres x 400 rotations, grid queries, streaming statistics) must
 // reject Eq. 14 and keep the exact finite-N law, by the likelihood ratio of the two laws with its

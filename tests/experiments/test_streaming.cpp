@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The streaming path (experiments/streaming.hpp): the same drops as the raw path, the same bits for
 // any thread count, and an interrupted-and-resumed run ends with the same bits as an uninterrupted one.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tangential laws in runs: the scene key material.tangential (parsed, refused where it does not
 // apply, written back by to_toml), and what the laws do to mesh bodies: Stronge's law never lets an
 // impact gain kinetic energy, single or in bounce sequences, where the paper's kinematic law and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fuzz target: the command line of validate-geometry (asperity::cli::parse_command_line).
 // Contract checked on every input: the parser returns a scene that passes validate() with finite
 // numbers, or throws BadInput with a message; anything else (another exception, a crash, a

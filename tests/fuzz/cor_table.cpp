@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fuzz target: the restitution-table reader a DEM code compiles (include/asperity/cor_table.h, C99).
 // Contract checked on every input: asperity_cor_parse returns 0 with a well-formed table (grids
 // ascending, sizes consistent, every sample finite and nondecreasing in u), or -1 with a message and

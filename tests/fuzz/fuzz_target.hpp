@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Shared by every fuzz target: how one input is split into arguments.
 #include <cstddef>

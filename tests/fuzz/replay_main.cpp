@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Replays a fuzz target's corpus without libFuzzer, in every build (any compiler): each file in
 // the given directories is fed to LLVMFuzzerTestOneInput once. Crashes found by fuzzing are kept
 // in tests/fuzz/regressions/<target>/ and replayed here forever.

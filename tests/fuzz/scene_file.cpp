@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Fuzz target: the scene-file parser (asperity::parse_scene, TOML format 1).
 // Contract checked on every input: parse_scene returns a scene that passes validate() and survives
 // a round trip through to_toml unchanged, or throws SceneError with a message naming where; any

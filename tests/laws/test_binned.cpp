@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Streaming statistics (laws/binned.hpp): merges are bit-identical to one pass, and every binned
 // test is calibrated (a true law rejected at ~alpha over many seeds) and has power (a wrong law
 // rejected at the sample size theory predicts). Each calibration states n, statistic and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The decisive test of explicit ensembles (laws/block_ks.hpp): binned KS of all drops with a
 // sphere-block bootstrap. Each statistical property is checked against an input it must reject.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The asymmetric Laplace law (paper Eq. 2) and its maximum-likelihood fit.
 #include <gtest/gtest.h>
 #include <omp.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Tests of asperity/statistics.hpp.
 //
 // Every random test uses a fixed seed of asperity::Stream (counter-based Philox, portable and

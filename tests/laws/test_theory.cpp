@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The analytic laws: internal consistency (pdf = cdf'), normalisation, limits, and agreement with
 // direct Monte Carlo of the same definition.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The Sec. IV laws (include/asperity/theory_impact.hpp, docs/sec4-derivations.md) against explicit
 // geometry: exact lowest-asperity contacts of fresh random spheres (fresh_cap) fed through the
 // full 3x3 impulse solve (solve_impact, eps_t = 1, eps_n = Pade [1/4] at the contact's normal

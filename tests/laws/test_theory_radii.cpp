@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Exact laws of the contact with level radii, the O(1) fresh sampler, and explicit bodies agree;
 // a deliberately wrong law is rejected by the same tests.
 #include <gtest/gtest.h>

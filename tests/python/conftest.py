@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Shared fixtures: small scenes and the CLI's report for the same scene and seed.
 
 Run by ctest (python.pytest) with PYTHONPATH at build/python and ASPERITY_CLI at validate-geometry;

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Restitution tables: the Python API, the files, and the C header reading them."""
 import json
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The vectorised core: rough spheres, contact queries, the impulse, eps_n models, the laws."""
 import gc
 

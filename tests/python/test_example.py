@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """examples/fig3.py runs and writes its figure."""
 import os
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """asperity.run against the CLI, the arrays, progress, Ctrl-C and bad input."""
 import math
 import os

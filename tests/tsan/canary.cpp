@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The TSan pass's power check: a deliberate data race in an OpenMP loop. scripts/test requires
 // ThreadSanitizer (with archer and the options it uses for the real tests) to REPORT it; a TSan
 // pass that stays silent here would be silent for real races too.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // File writes that never leave a partial file: every file of a run goes through here.
 #include <filesystem>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Checkpoints of a streaming run (issue 14, item 4): the statistics so far, where to continue and
 // the scene, in the run's output directory, written atomically (write_file_atomic):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The processes of one run split across machines (validate-geometry under mpirun, issue 14): the
 // app's only view of them, so that no library needs MPI. A run without a Collective is one process.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Restitution tables for DEM codes (README "Restitution tables"): the distribution of the
 // macroscopic restitution coefficient eps of the paper's rough sphere, as quantiles on a fine

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // What a run leaves behind when it is interrupted: nothing. install_interrupt_cleanup() makes
 // SIGINT, SIGTERM, SIGHUP and SIGPIPE kill the registered child process group (gnuplot), remove

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Mesh files: reading (CGAL, with the checks a solid body needs) and PLY export of rough bodies.
 #include <filesystem>

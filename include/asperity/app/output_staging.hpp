@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // All or nothing in the output directory. A run writes every file (figures, PLY, report) into a
 // private staging directory inside the output directory; commit() renames them into place only

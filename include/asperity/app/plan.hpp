@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The planner: from a scene's requested outputs, the stages a run needs -- and nothing else.
 // Every stage is listed, run or skipped, with the reason; report.json carries the list (`plan`)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Publication-style PNG figures of measured histograms against analytic laws, drawn by gnuplot
 // (pngcairo). A figure is a value (laws/figure.hpp); writing it is one call.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // What a run found, as a value: per-quantity summaries, one entry per (quantity, law) test with a
 // verdict, core-contact counts and timings. Rendered as a table for people, as report.json for

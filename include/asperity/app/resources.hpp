@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Memory refused up front, not discovered: the peak resident memory of a run estimated from
 // measured costs (per asperity of each contact index, per concurrently built sphere or body, per

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // One call runs a scene as validate-geometry does: plan, ensemble, analysis, figures.
 #include <filesystem>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // A scene: everything one run of validate-geometry needs, with named presets that reproduce the
 // paper's figures. Every field is validated before any work starts. Scenes are written as TOML

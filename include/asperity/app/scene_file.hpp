@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Scene files: a versioned TOML format (format = 1) describing one run -- body, material,
 // asperities, ensemble, experiment, outputs. Documented in README "Scenes" and, key by key, in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The report of a run on the streaming path (experiments/streaming.hpp): the same GeometryReport
 // as analyse() gives for raw samples, with tests evaluated on the binned data (laws/binned.hpp),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // General rough bodies (beyond the paper): a rigid base body carrying N spherical asperities of
 // UNEQUAL radii. Asperity i is a ball with centre c_i and radius rho_i in the BODY frame, with

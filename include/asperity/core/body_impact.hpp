@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // A single impact of a general rough body (body.hpp) on the plate, with its full inertia tensor:
 // the touching asperity from the exact support query, J rotated into the world frame

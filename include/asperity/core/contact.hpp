@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Which asperity touches the plate: one query interface over interchangeable spatial structures.
 //

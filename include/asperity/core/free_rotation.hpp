@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Torque-free rotation of a rigid body with a general inertia tensor (the asymmetric top): what a
 // non-spherical rough body does between two impacts. In flight only gravity acts, through the

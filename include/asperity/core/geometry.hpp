@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Rough spheres: a central sphere of radius R (the paper's varrho) carrying N spherical asperities
 // of radius a (the paper's rho) whose centres lie ON the central sphere (paper Eq. 11).

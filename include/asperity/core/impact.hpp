@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The collision of a rigid rough body with a flat plate as an instantaneous impulse (paper Eqs.
 // 3-7). Frame: the world frame of orientation.hpp, z UP; the plate's unit normal n points OUT of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // A lazy exact rough sphere: N iid uniform asperity centres on the unit sphere, of which only the
 // part a query touches is ever generated.

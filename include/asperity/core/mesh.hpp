@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Bodies from triangle meshes (meshes/*.off, made by scripts/make_meshes.py): mass properties
 // of the closed mesh and asperities tiled uniformly by area. Files: app/mesh_io.hpp.

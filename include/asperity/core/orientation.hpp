@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Orientations of a body. World frame: z points UP, the plate is below the body and its outward
 // normal is +z; "down" is -z. A rotation q maps body coordinates to world coordinates.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Microscopic coefficients of normal restitution eps_n(v) of a smooth contact, as functions of the
 // normal contact speed v = |(V + Omega x r) . n| [m/s] (paper, text after Eq. 21).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Screening (paper, Sec. V: "smaller asperities would be screened by larger ones"): which
 // asperities of a rough SPHERE with unequal radii can touch the plate in some orientation.

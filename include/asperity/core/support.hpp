@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Which asperity of a general rough body (body.hpp) touches the plate: the exact support query.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Tangential contact laws for the impact of a rigid body on a plate, behind one interface
 // (docs/tangential-laws.md derives each):

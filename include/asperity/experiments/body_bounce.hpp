@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Bounce sequences of general rough bodies (body.hpp: mesh bodies, spheres with fixed or unequal
 // radii): the body is dropped on the plate and left to bounce. Between impacts the centre of mass

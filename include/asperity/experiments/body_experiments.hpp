@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Experiments beyond the paper, as values in and values out (the lead wires them to the scene
 // format): (1) unequal asperity radii on a sphere: screening, effective density and the law of

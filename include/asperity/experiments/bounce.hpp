@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The bouncing ball of the paper's Sec. V: a rough sphere dropped onto a plate bounces until its
 // impact speed falls below a threshold; the restitution coefficients of all its impacts are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Ensembles of drops: rough spheres meeting the plate. Two designs, named in every report:
 //  - explicit (the default): K explicit spheres of N asperities x M Haar-random rotations each;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The streaming path of a contact ensemble (issue 14): the same drops as run_contact_ensemble (same
 // spheres, rotations and streams), but each drop's r_xy, r_x, r_y goes straight into integer

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Streaming, mergeable statistics of one quantity (issue 14): memory independent of the number of
 // samples, merged with the same bits for any thread count, rank count or schedule.

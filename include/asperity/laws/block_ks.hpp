@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The decisive goodness-of-fit test of an explicit ensemble: a KS statistic on ALL drops of K
 // spheres x M rotations, with a null distribution that accounts for the spread between spheres.

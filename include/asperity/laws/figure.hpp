@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Figures as values: a measured histogram with the analytic laws to overlay. The layers below app/
 // build them; app/plot.hpp renders them (gnuplot), so no experiment writes a file.

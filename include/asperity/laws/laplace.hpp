@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The asymmetric Laplace law of the paper's Eq. 2 and its maximum-likelihood fit.
 //

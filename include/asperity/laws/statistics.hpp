@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Sample statistics with honest uncertainties: histograms with Poisson error bars, one- and
 // two-sample Kolmogorov-Smirnov tests with p-values, binned chi-square, and means, standard

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Analytic laws for the contact vector of a rough sphere (paper Sec. III), each as a value with
 // a pdf and a cdf, so that tests, plots and reports can treat laws uniformly.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Laws of the paper's Sec. IV for the macroscopic restitution coefficient eps and the spin after
 // the impact, each "as printed" and "as corrected" (derivations in docs/sec4-derivations.md).

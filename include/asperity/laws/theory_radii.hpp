@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The contact of a rough sphere whose asperity radii take discrete levels (body.hpp,
 // RadiusDistribution::Kind::levels or fixed): an exact O(1) fresh-sphere sampler and the exact

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The verdict of a statistical test on a law: one enum for every report (no strings compared by
 // hand). Its spelling in report.json and tables is to_string's.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The command line of validate-geometry, parsed into a validated Scene without touching the file
 // system: main() and the fuzz target (tests/fuzz/cli_options.cpp) call the same function.

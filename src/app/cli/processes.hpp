@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The processes of a validate-geometry run started by an MPI launcher (mpirun, srun): issue 14's
 // "beyond one machine". Only the executable knows MPI; the libraries see a Collective.

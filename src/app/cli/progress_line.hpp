@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // The progress line of validate-geometry on stderr: silent for runs shorter than a second, one
 // overwritten line on a terminal, a line per 10% otherwise. The clock and the stream are

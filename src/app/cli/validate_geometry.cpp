@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // validate-geometry: run a scene of explicit rough spheres, compare the contact statistics with
 // the paper's laws and the exact finite-N laws, print a table, write report.json and figures.
 // Exit status: 0 no law rejected (skipped laws: a warning), 1 a law rejected, 2 bad input or an

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // The reference: a linear scan in canonical order. Every other backend is tested against it.
 #include "core/contact/detail.hpp"
 

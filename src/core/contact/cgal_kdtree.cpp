@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // kd-tree backend on CGAL 5.5 Spatial_searching (a baseline next to nanoflann).
 //
 // The tree holds (Point_3, Tag) pairs through Search_traits_adapter, so a leaf scan reads

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // FCL 0.7 backend (a baseline): the asperity centres as tiny spheres in a dynamic AABB tree,
 // queried by a broad-phase distance traversal with our own callback.
 //

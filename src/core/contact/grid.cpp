@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // Cube-map grid backend: the unit centres are bucketed on the six faces of a cube (gnomonic
 // projection) and a query scans a rectangle of cells around the down direction, growing it until
 // an exact lower bound on the key of every point outside the rectangle exceeds the runner-up key.

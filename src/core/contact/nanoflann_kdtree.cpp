@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
 // kd-tree backend on nanoflann (Debian's 1.4.3, old API: squared distances, SearchParams).
 //
 // Exactness: instead of nanoflann's KNN result set (which breaks ties by traversal order) we pass
