@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "asperity/app/plot.hpp"
+#include "asperity/config.hpp"
 #include "asperity/core/random.hpp"
 #include "asperity/laws/block_ks.hpp"
 #include "asperity/laws/theory.hpp"
@@ -655,6 +656,7 @@ std::string to_json(const GeometryReport& r) {
   json j;
   j["schema_version"] = kReportSchemaVersion;
   j["tool"] = "validate-geometry";
+  j["tool_version"] = ASPERITY_VERSION;
   j["scene"] = r.scene.name;
   j["mode"] = std::string(to_string(e.mode));
   j["samples"] = r.samples;
@@ -703,6 +705,7 @@ std::string with_header(const std::string& body, const ReportHeader& h) {
   if (!j.is_object()) throw std::invalid_argument("with_header: the report body must be a JSON object");
   j["schema_version"] = kReportSchemaVersion;
   j["tool"] = h.tool;
+  j["tool_version"] = ASPERITY_VERSION;
   j["scene"] = h.scene;
   if (!h.scene_toml.empty()) j["scene_file"] = h.scene_toml;
   if (!h.plan.empty()) j["plan"] = plan_json(h.plan);

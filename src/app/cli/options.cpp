@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "asperity/app/scene_file.hpp"
+#include "asperity/config.hpp"
 
 namespace asperity::cli {
 
@@ -189,14 +190,18 @@ void refuse_empty_equals(std::span<const std::string> args) {
   }
 }
 
-// CLI11's parse; false when --help was asked for. Unknown arguments are BadInput.
-bool parse_arguments(CLI::App& app, std::span<const std::string> args) {
+enum class Parsed { run, help, version };
+
+// CLI11's parse: whether to run, or print help or the version. Unknown arguments are BadInput.
+Parsed parse_arguments(CLI::App& app, std::span<const std::string> args) {
   app.allow_extras();
   try {
     std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 consumes from the back
     app.parse(reversed);
   } catch (const CLI::CallForHelp&) {
-    return false;
+    return Parsed::help;
+  } catch (const CLI::CallForVersion&) {
+    return Parsed::version;
   } catch (const CLI::ParseError& e) {
     throw BadInput(std::string(e.what()) + "\nRun with --help for more information.");
   }
@@ -206,8 +211,17 @@ bool parse_arguments(CLI::App& app, std::span<const std::string> args) {
     for (const auto& x : extra) list += " " + x;
     throw BadInput("The following arguments were not expected:" + list + "\nRun with --help for more information.");
   }
-  return true;
+  return Parsed::run;
 }
+
+// What --help ends with: the exit status is part of the interface (scripts and Slurm arrays test it).
+constexpr const char* kHelpFooter =
+    "\nExit status:\n"
+    "  0  the run completed and no decisive law was rejected\n"
+    "  1  the run completed and the decisive family rejected a law (report.json \"rejected\")\n"
+    "  2  bad input or failure (the message names the option, key or file); the output directory\n"
+    "     is left as it was\n"
+    "\nManual: docs/README.md in the source tree (user guide, scene keys, report.json schema).\n";
 
 // Presence, not emptiness: `--radius ''` is a bad value, not a missing option.
 struct Given {
@@ -509,12 +523,21 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
                "validate-geometry"};
   RawOptions raw;
   add_options(app, raw);
+  app.set_version_flag("--version", std::string("validate-geometry ") + ASPERITY_VERSION);
+  app.footer(kHelpFooter);
   Options o;
   refuse_empty_equals(args);
-  if (!parse_arguments(app, args)) {
-    o.help = true;
-    o.help_text = app.help();
-    return o;
+  switch (parse_arguments(app, args)) {
+    case Parsed::help:
+      o.help = true;
+      o.help_text = app.help();
+      return o;
+    case Parsed::version:
+      o.help = true;  // printed like --help: exit 0, nothing else done
+      o.help_text = std::string("validate-geometry ") + ASPERITY_VERSION + "\n";
+      return o;
+    case Parsed::run:
+      break;
   }
   try {
     o.scene = scene_with_options(raw, Given{app}, load);

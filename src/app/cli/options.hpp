@@ -19,7 +19,7 @@ struct BadInput : std::runtime_error {
 struct Options {
   Scene scene;             ///< validated (asperity::validate) unless `help`
   bool quiet = false;      ///< --quiet: no progress lines
-  bool help = false;       ///< --help was given: print help_text, exit 0, nothing else
+  bool help = false;       ///< --help or --version was given: print help_text, exit 0, nothing else
   std::string help_text;
 };
 
