@@ -8,25 +8,84 @@
 #include <CGAL/Surface_mesh.h>
 
 #include <cmath>
+#include <fstream>
+#include <new>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
 
 #include "asperity/app/atomic_file.hpp"
+#include "asperity/app/bounded_read.hpp"
 #include "core/format.hpp"
 
 namespace asperity {
 
 using detail::num;
 
+namespace {
+
+/// Largest mesh file read: ~20 M triangles of ASCII OFF. A mesh body is the smooth shape under
+/// the asperities; nothing asperity does needs more.
+constexpr std::uint64_t kMaxMeshBytes = std::uint64_t{1} << 30;
+
+/// The element counts an OFF or PLY header claims must fit in the file: every vertex or face takes
+/// at least 6 bytes in any encoding ("0 0 0\n"; binary: 3 floats), so a header claiming 2e9
+/// vertices in a small file is refused by name before the mesh library allocates for them.
+void check_header_counts(const std::filesystem::path& file, std::uint64_t size) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(4096, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  std::istringstream is(head);
+  std::string word;
+  long double claimed = 0;
+  if (!(is >> word)) return;
+  if (word == "OFF") {
+    std::string line;
+    std::getline(is, line);
+    while (std::getline(is, line)) {  // the first line that is not a comment holds the counts
+      if (line.find_first_not_of(" \t\r") == std::string::npos || line[line.find_first_not_of(" \t\r")] == '#') continue;
+      std::istringstream counts(line);
+      long double nv = 0, nf = 0;
+      if (counts >> nv >> nf) claimed = nv + nf;
+      break;
+    }
+  } else if (word == "ply") {
+    std::string line;
+    while (std::getline(is, line) && line.rfind("end_header", 0) != 0) {
+      std::istringstream e(line);
+      std::string kw, name;
+      long double n = 0;
+      if (e >> kw >> name >> n && kw == "element") claimed += n;
+    }
+  }
+  if (claimed * 6 > static_cast<long double>(size))
+    throw std::invalid_argument("mesh file '" + file.string() + "': its header claims " + num(static_cast<double>(claimed)) +
+                                " vertices and faces, more than its " + std::to_string(size) + " bytes can hold");
+}
+
+}  // namespace
+
 TriangleMesh read_mesh(const std::filesystem::path& file, double scale) {
   using K = CGAL::Exact_predicates_inexact_constructions_kernel;
   using Mesh = CGAL::Surface_mesh<K::Point_3>;
   const std::string f = file.string();
   if (!std::isfinite(scale) || scale <= 0) throw std::invalid_argument("mesh scale must be finite and > 0, got " + num(scale));
-  if (!std::filesystem::is_regular_file(file)) throw std::invalid_argument("mesh file '" + f + "' does not exist");
+  std::uint64_t size = 0;
+  try {
+    size = checked_input_size(file, kMaxMeshBytes, "mesh file");
+  } catch (const InputFileError& e) {
+    throw std::invalid_argument(e.what());
+  }
+  check_header_counts(file, size);
   Mesh sm;
-  if (!CGAL::Polygon_mesh_processing::IO::read_polygon_mesh(f, sm) || sm.number_of_faces() == 0)
+  bool read = false;
+  try {
+    read = CGAL::Polygon_mesh_processing::IO::read_polygon_mesh(f, sm);
+  } catch (const std::bad_alloc&) {
+    throw std::invalid_argument("mesh file '" + f + "': not enough memory to read it (" + std::to_string(size) + " bytes)");
+  }
+  if (!read || sm.number_of_faces() == 0)
     throw std::invalid_argument("mesh file '" + f + "' could not be read as a polygon mesh (OFF, PLY, STL, OBJ)");
   if (!CGAL::is_triangle_mesh(sm)) throw std::invalid_argument("mesh '" + f + "' is not a triangle mesh");
   if (!CGAL::is_closed(sm)) throw std::invalid_argument("mesh '" + f + "' is not closed (it has border edges)");

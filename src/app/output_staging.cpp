@@ -43,7 +43,22 @@ std::string output_name_problem(std::string_view name) {
   return "";
 }
 
+// A constructor that throws runs no destructor: the directories made before the failure (a deep
+// --out whose last component cannot be created) are removed here, or they would stay behind.
 OutputStaging::OutputStaging(const fs::path& out) : out_(out) {
+  try {
+    create(out);
+  } catch (...) {
+    remove_created_directories();
+    throw;
+  }
+}
+
+void OutputStaging::remove_created_directories() noexcept {
+  for (auto it = created_.rbegin(); it != created_.rend(); ++it) ::rmdir(it->c_str());
+}
+
+void OutputStaging::create(const fs::path& out) {
   if (out.empty()) throw std::runtime_error("output directory: empty name");
   // The missing directories, outermost first: each is created (and remembered) in turn.
   std::vector<fs::path> missing;
@@ -90,8 +105,7 @@ OutputStaging::OutputStaging(const fs::path& out) : out_(out) {
 OutputStaging::~OutputStaging() {
   std::error_code ec;
   fs::remove_all(dir_, ec);
-  if (!committed_)
-    for (auto it = created_.rbegin(); it != created_.rend(); ++it) ::rmdir(it->c_str());
+  if (!committed_) remove_created_directories();
 }
 
 void OutputStaging::add(const std::string& name) {

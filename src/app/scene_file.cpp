@@ -2,6 +2,7 @@
 // Scene files (format 1). toml++ is used header-only, in this translation unit only.
 #include "asperity/app/scene_file.hpp"
 
+#include "asperity/app/bounded_read.hpp"
 #include "asperity/app/output_staging.hpp"
 
 #define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
@@ -292,7 +293,7 @@ TangentialLaw read_tangential(Reader& t) {
   auto mu = [&] {
     const auto m = t.real("mu");
     if (!m) t.missing("mu", "the friction coefficient, e.g. 0.1");
-    if (*m < 0) t.bad("mu", "must be >= 0, got " + num(*m));
+    if (!(*m >= 0 && *m <= TangentialLaw::kMaxMu)) t.bad("mu", "must be in [0, 1e12] (1e12 already sticks every impact), got " + num(*m));
     return *m;
   };
   TangentialLaw law;
@@ -826,10 +827,29 @@ struct SyntaxProblem {
   const char* what = "";
 };
 
+// Bounds checked before toml++ sees the text: toml++ recurses per dotted-key part and per nested
+// array or inline table (a header of 40,000 parts overflowed its stack). No scene key of asperity
+// has more than 3 parts, nor any value more than 2 levels of nesting; the limits leave room.
+constexpr std::size_t kMaxSceneBytes = std::size_t{1} << 20;  ///< 1 MiB: a scene is a few hundred bytes
+constexpr std::size_t kMaxKeyDots = 15;                       ///< a dotted key of at most 16 parts
+constexpr std::size_t kMaxNesting = 16;                       ///< arrays / inline tables inside each other
+
+// Counts the dots of the dotted key being read (between separators), outside strings and comments.
+// A number has at most one dot and a date or time one, so only a key reaches the limit.
+struct KeyDots {
+  std::size_t dots = 0;
+  bool see(char c) {  // true when the key has too many parts
+    if (c == '.') return ++dots > kMaxKeyDots;
+    if (c == '=' || c == ',' || c == '[' || c == '{' || c == ']' || c == '}' || c == '\n') dots = 0;
+    return false;
+  }
+};
+
 SyntaxProblem bad_brackets(std::string_view t) {
   std::size_t line = 1;
   bool line_start = true, in_header = false;
   std::string open;  // the [ and { open inside a value, innermost last
+  KeyDots key;
   const std::size_t n = t.size();
   // Scene files are ASCII: toml++ 3.3 reaches TOML_UNREACHABLE (undefined behaviour) classifying
   // some non-ASCII characters, in bare keys and inside strings alike (found by fuzzing).
@@ -839,6 +859,7 @@ SyntaxProblem bad_brackets(std::string_view t) {
   }
   for (std::size_t i = 0; i < n; ++i) {
     const char c = t[i];
+    if (key.see(c)) return {line, "a dotted key of more than 16 parts (no scene key has more than 3)"};
     if (c == '\n') {
       ++line;
       in_header = false;
@@ -890,6 +911,7 @@ SyntaxProblem bad_brackets(std::string_view t) {
     if (in_header) continue;
     if (c == '[' || c == '{') {
       open.push_back(c);
+      if (open.size() > kMaxNesting) return {line, "arrays or inline tables nested more than 16 deep"};
     } else if ((c == ']' || c == '}') && !open.empty()) {
       // toml++ 3.3 asserts (debug) or misbehaves on a closer that does not match, e.g. [0, 1,}2].
       if ((c == ']') != (open.back() == '[')) return {line, c == ']' ? "']' closes an inline table" : "'}' closes an array"};
@@ -928,6 +950,10 @@ std::filesystem::path resolve_mesh(const std::filesystem::path& mesh, const std:
 }  // namespace
 
 Scene parse_scene(std::string_view toml_text, std::string_view origin) {
+  if (toml_text.size() > kMaxSceneBytes)
+    throw SceneError(std::string(origin) + ": a scene is at most 1 MiB of TOML, this one has " +
+                         std::to_string(toml_text.size()) + " bytes",
+                     "");
   if (const SyntaxProblem bad = bad_brackets(toml_text); bad.line != 0)
     throw SceneError(std::string(origin) + ":" + std::to_string(bad.line) + ": TOML syntax error: " + bad.what, "");
   toml::table root;
@@ -942,13 +968,13 @@ Scene parse_scene(std::string_view toml_text, std::string_view origin) {
 }
 
 Scene load_scene(const std::filesystem::path& file) {
-  std::ifstream f(file, std::ios::binary);
-  std::error_code ec;
-  if (!f || std::filesystem::is_directory(file, ec)) throw SceneError("cannot read scene file '" + file.string() + "'", "");
-  std::ostringstream text;
-  text << f.rdbuf();
-  if (!f && !f.eof()) throw SceneError("cannot read scene file '" + file.string() + "'", "");
-  Scene s = parse_scene(text.str(), file.string());
+  std::string text;
+  try {
+    text = read_bounded_file(file, kMaxSceneBytes, "scene file");
+  } catch (const InputFileError& e) {
+    throw SceneError(e.what(), "");
+  }
+  Scene s = parse_scene(text, file.string());
   if (s.mesh) s.mesh->file = resolve_mesh(s.mesh->file, file, file.parent_path());
   return s;
 }

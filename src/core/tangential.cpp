@@ -82,7 +82,10 @@ std::string TangentialLaw::describe() const {
 
 void validate(const TangentialLaw& l) {
   if (!std::isfinite(l.eps_t)) throw std::invalid_argument("tangential eps_t must be finite, got " + num(l.eps_t));
-  if (!std::isfinite(l.mu) || l.mu < 0) throw std::invalid_argument("tangential mu must be finite and >= 0, got " + num(l.mu));
+  // Above ~1e12 every impact sticks anyway (the tests' sticking limit is 1e7); far above it mu |A|
+  // overflows the slip direction's step control and the process never ends (seen at 1e160).
+  if (!(l.mu >= 0 && l.mu <= TangentialLaw::kMaxMu))
+    throw std::invalid_argument("tangential mu must be in [0, 1e12] (1e12 already sticks every impact), got " + num(l.mu));
   if (!std::isfinite(l.beta0) || l.beta0 < -1 || l.beta0 > 1)
     throw std::invalid_argument("tangential beta0 must be in [-1, 1], got " + num(l.beta0));
 }

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/experiments/body_bounce.hpp"
+#include "asperity/core/parallel_errors.hpp"
 
 #include <omp.h>
 
@@ -196,12 +197,15 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
   std::vector<std::unique_ptr<SupportQuery>> trees(bodies.size());
   std::vector<BodyBounds> bounds(bodies.size());
   const auto nb = static_cast<std::int64_t>(bodies.size());
+  LowestIndexError index_error;
 #pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
-  for (std::int64_t k = 0; k < nb; ++k) {
-    const auto& b = bodies[static_cast<std::size_t>(k)];
-    trees[static_cast<std::size_t>(k)] = make_support_tree(b.centres, b.radii);
-    bounds[static_cast<std::size_t>(k)] = BodyBounds::of(b);
-  }
+  for (std::int64_t k = 0; k < nb; ++k)
+    index_error.run(k, [&] {
+      const auto& b = bodies[static_cast<std::size_t>(k)];
+      trees[static_cast<std::size_t>(k)] = make_support_tree(b.centres, b.radii);
+      bounds[static_cast<std::size_t>(k)] = BodyBounds::of(b);
+    });
+  index_error.rethrow();
   const double seconds_index = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const auto t1 = std::chrono::steady_clock::now();
   const auto eps_n = viscoelastic_pade14(o.bounce.beta);
@@ -214,13 +218,17 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
   std::vector<SequenceOut> outs(static_cast<std::size_t>(std::min(chunk, n)));
   for (std::uint64_t start = 0; start < n; start += chunk) {
     const auto m = static_cast<std::int64_t>(std::min(chunk, n - start));
+    // A sequence can throw (an impulse process that does not end): kept, not std::terminate.
+    LowestIndexError sequence_error;
 #pragma omp parallel for num_threads(nt) schedule(dynamic, 1)
-    for (std::int64_t j = 0; j < m; ++j) {
-      const std::uint64_t s = start + static_cast<std::uint64_t>(j);
-      auto& out = outs[static_cast<std::size_t>(j)];
-      out.impacts.clear();
-      run_sequence(s, bodies[s % K], bounds[s % K], *trees[s % K], o, *eps_n, seed, out);
-    }
+    for (std::int64_t j = 0; j < m; ++j)
+      sequence_error.run(j, [&] {
+        const std::uint64_t s = start + static_cast<std::uint64_t>(j);
+        auto& out = outs[static_cast<std::size_t>(j)];
+        out.impacts.clear();
+        run_sequence(s, bodies[s % K], bounds[s % K], *trees[s % K], o, *eps_n, seed, out);
+      });
+    sequence_error.rethrow();
     // Appended in sequence order: identical for any thread count and schedule.
     for (std::int64_t j = 0; j < m; ++j) {
       const auto& out = outs[static_cast<std::size_t>(j)];

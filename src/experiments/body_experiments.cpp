@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/experiments/body_experiments.hpp"
+#include "asperity/core/parallel_errors.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -69,8 +70,10 @@ void for_drops(std::uint64_t n, std::uint64_t offset, std::uint64_t total, const
   for (std::uint64_t b = 0; b < n; b += kChunk) {
     const std::uint64_t end = std::min(n, b + kChunk);
     const auto m = static_cast<std::int64_t>(end - b);
+    LowestIndexError error;
 #pragma omp parallel for schedule(static)
-    for (std::int64_t j = 0; j < m; ++j) f(b + static_cast<std::uint64_t>(j));
+    for (std::int64_t j = 0; j < m; ++j) error.run(j, [&] { f(b + static_cast<std::uint64_t>(j)); });
+    error.rethrow();
     if (progress) progress(offset + end, total);
   }
 }

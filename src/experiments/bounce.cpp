@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/experiments/bounce.hpp"
+#include "asperity/core/parallel_errors.hpp"
 
 #include <omp.h>
 
@@ -299,19 +300,25 @@ BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b,
   std::vector<std::unique_ptr<LazySphere>> spheres(static_cast<std::size_t>(std::max(1, nt)));
   for (std::uint64_t start = 0; start < b.sequences; start += chunk) {
     const std::int64_t m = static_cast<std::int64_t>(std::min(chunk, b.sequences - start));
+    LowestIndexError error;  // an exception must not leave the parallel region
 #pragma omp parallel num_threads(nt)
     {
       auto& S = spheres[static_cast<std::size_t>(omp_get_thread_num())];
-      if (explicit_geometry && !S) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0, 8, modes.get());
+      error.run(-1, [&] {
+        if (explicit_geometry && !S) S = std::make_unique<LazySphere>(sphere.asperities, seed, 0, 8, modes.get());
+      });
 #pragma omp for schedule(dynamic, 8)
-      for (std::int64_t j = 0; j < m; ++j) {
-        auto& o = outs[static_cast<std::size_t>(j)];
-        o.impacts.clear(), o.cut = false, o.cells = o.centres = 0;
-        const std::uint64_t i = start + static_cast<std::uint64_t>(j);
-        if (explicit_geometry) run_explicit(i, v, b, p, seed, *S, o);
-        else run_paper(i, v, b, p, seed, o);
-      }
+      for (std::int64_t j = 0; j < m; ++j)
+        if (!error.failed())
+          error.run(j, [&] {
+            auto& o = outs[static_cast<std::size_t>(j)];
+            o.impacts.clear(), o.cut = false, o.cells = o.centres = 0;
+            const std::uint64_t i = start + static_cast<std::uint64_t>(j);
+            if (explicit_geometry) run_explicit(i, v, b, p, seed, *S, o);
+            else run_paper(i, v, b, p, seed, o);
+          });
     }
+    error.rethrow();
     // Append in sequence order: identical for any thread count and schedule.
     if (start == 0) reserve_samples(s, outs, static_cast<std::size_t>(m), b.sequences);
     for (std::int64_t j = 0; j < m; ++j) {
@@ -339,18 +346,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::vector<double> eps_n_of_impacts(const BounceSamples& s, double beta) {
   const auto en = viscoelastic_pade14(beta);
   std::vector<double> e(s.speed.size());
-  std::exception_ptr error;
+  LowestIndexError error;
   const auto n = static_cast<std::int64_t>(e.size());
 #pragma omp parallel for schedule(static)
-  for (std::int64_t j = 0; j < n; ++j) {
-    try {
-      e[static_cast<std::size_t>(j)] = (*en)(s.speed[static_cast<std::size_t>(j)]);
-    } catch (...) {
-#pragma omp critical(bounce_eps_n)
-      if (!error) error = std::current_exception();  // must not leave the parallel region
-    }
-  }
-  if (error) std::rethrow_exception(error);
+  for (std::int64_t j = 0; j < n; ++j)
+    error.run(j, [&] { e[static_cast<std::size_t>(j)] = (*en)(s.speed[static_cast<std::size_t>(j)]); });
+  error.rethrow();
   return e;
 }
 

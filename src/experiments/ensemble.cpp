@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/experiments/ensemble.hpp"
+#include "asperity/core/parallel_errors.hpp"
 
 #include <omp.h>
 
@@ -219,12 +220,9 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
   std::vector<double> eps(n), wx(n), en(n);
   std::vector<std::uint8_t> hit(n);
   const std::int64_t ni = static_cast<std::int64_t>(n);
-  // An exception must not leave an OpenMP region (std::terminate): keep the one of the lowest
-  // drop, so the error is the same for any thread count, and rethrow it after the loop.
-  std::exception_ptr error;
-  std::int64_t error_drop = ni;
+  LowestIndexError error;  // the error of the lowest drop: the same for any thread count
 #pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < ni; ++i) try {
+  for (std::int64_t i = 0; i < ni; ++i) error.run(i, [&] {
     const std::size_t k = static_cast<std::size_t>(i);
     ImpactState st;
     st.V = Vec3(0, 0, -x.speed);
@@ -232,19 +230,16 @@ void run_impacts(const EnsembleConfig& c, ContactSamples& s) {
     st.r = s.core[k] ? Vec3(0, 0, -R) : Vec3(s.r_x[k], s.r_y[k], s.r_z[k]);
     st.n = Vec3(0, 0, 1);
     const double vn = (st.V + st.Omega.cross(st.r)).dot(st.n);
-    if (!(vn < 0)) continue;
+    if (!(vn < 0)) return;
     const double e = (*eps_n)(-vn);
     // The paper's kinematic law in closed form; another tangential law by its impulse process.
     const auto out = x.tangential.model == TangentialLaw::Model::kinematic
                          ? solve_impact_isotropic(mass, inertia, st, e, x.eps_t)
                          : solve_impact(RigidBody{mass, Eigen::Matrix3d::Identity() * inertia}, st, e, x.tangential);
-    if (!out) continue;
+    if (!out) return;
     hit[k] = 1, eps[k] = out->eps, wx[k] = out->Omega_after.x(), en[k] = e;
-  } catch (...) {
-#pragma omp critical(asperity_impact_error)
-    if (i < error_drop) error_drop = i, error = std::current_exception();
-  }
-  if (error) std::rethrow_exception(error);
+  });
+  error.rethrow();
   // Compact in drop order: deterministic for any thread count.
   for (std::size_t k = 0; k < n; ++k) {
     if (!hit[k]) {

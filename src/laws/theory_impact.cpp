@@ -672,6 +672,10 @@ std::vector<BounceResidualLaw> bounce_residual_laws(const ImpactScene& s0, unsig
   std::vector<BounceResidualLaw> out;
   double u = s.speed, S2 = 0;
   for (unsigned k = 1; k <= k_max; ++k) {
+    // The linearised law predicts the k-th impact speed; where it predicts none (a spread of r so
+    // wide that -- e.g. N = 1 -- the mean rebound turns negative) the law of that impact and of
+    // every later one does not exist: the groups that need it get no theory test.
+    if (!(u > 0) || !std::isfinite(u)) break;
     s.speed = u;
     const auto p = impact_law_parameters(s);
     BounceResidualLaw L;

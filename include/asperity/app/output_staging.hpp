@@ -44,6 +44,8 @@ class OutputStaging {
   std::vector<std::filesystem::path> commit();
 
  private:
+  void create(const std::filesystem::path& out);  ///< the constructor's work; throws
+  void remove_created_directories() noexcept;      ///< deepest first, only if still empty
   std::filesystem::path out_, dir_;
   std::vector<std::filesystem::path> created_;  ///< directories this run created, parents first
   std::vector<std::unique_ptr<InterruptCleanup>> guards_;

@@ -31,7 +31,8 @@ struct TangentialLaw {
 
   Model model = Model::kinematic;
   double eps_t = 1.0;       ///< kinematic: v'_t = eps_t v_t
-  double mu = 0.0;          ///< coulomb, walton: friction coefficient (>= 0)
+  double mu = 0.0;          ///< coulomb, walton: friction coefficient, in [0, kMaxMu]
+  static constexpr double kMaxMu = 1e12;  ///< every impact sticks long before; see validate()
   double beta0 = -1.0;      ///< walton: tangential restitution when sticking, v'_t = -beta0 v_t, in [-1, 1]
   Normal normal = Normal::energetic;
 

@@ -130,7 +130,7 @@ struct BounceResidualLaw {
   double cdf(double t) const;  ///< of the residual
   double mean() const { return a2 - a1; }
 };
-/// Laws for k = 1 ... k_max (index k - 1).
+/// Laws for k = 1 ... k_max (index k - 1); fewer when the linearised speed of impact k is not > 0.
 std::vector<BounceResidualLaw> bounce_residual_laws(const ImpactScene& s, unsigned k_max, bool paper_route = false);
 
 }  // namespace asperity

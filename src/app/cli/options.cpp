@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "asperity/app/plan.hpp"
+#include "asperity/app/run.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/config.hpp"
 
@@ -192,6 +194,18 @@ void refuse_empty_equals(std::span<const std::string> args) {
 
 enum class Parsed { run, help, version };
 
+// `--out --no-plots` would take "--no-plots" as the directory: a value that is the name of one of
+// our options is a forgotten value, never meant. (A directory really named so: ./--no-plots.)
+void refuse_options_as_values(const CLI::App& app) {
+  for (const CLI::Option* opt : app.get_options()) {
+    if (opt->get_expected_min() == 0) continue;  // a flag: no value
+    for (const std::string& v : opt->results())
+      if (v.size() > 1 && v[0] == '-' && app.get_option_no_throw(v) != nullptr)
+        throw BadInput(opt->get_name() + ": '" + v + "' is an option, not a value; give " + opt->get_name() +
+                       " a value (a name that starts with '-' can be written ./" + v + ")");
+  }
+}
+
 // CLI11's parse: whether to run, or print help or the version. Unknown arguments are BadInput.
 Parsed parse_arguments(CLI::App& app, std::span<const std::string> args) {
   app.allow_extras();
@@ -211,6 +225,7 @@ Parsed parse_arguments(CLI::App& app, std::span<const std::string> args) {
     for (const auto& x : extra) list += " " + x;
     throw BadInput("The following arguments were not expected:" + list + "\nRun with --help for more information.");
   }
+  refuse_options_as_values(app);
   return Parsed::run;
 }
 
@@ -234,13 +249,13 @@ struct Given {
 [[noreturn]] void refuse(const std::string& option, const std::string& why) { throw BadInput(option + ": " + why); }
 
 // The kind of run a scene is, for the options that apply to some kinds only.
-struct RunKind {
+struct OptionKind {
   bool bounce = false, mesh = false, radii = false;
   std::string text;  ///< named in refusals
 };
 
-RunKind run_kind(const Scene& scene) {
-  RunKind k;
+OptionKind option_kind(const Scene& scene) {
+  OptionKind k;
   k.bounce = scene.bounce.enabled, k.mesh = scene.mesh.has_value(), k.radii = scene.radii && !scene.mesh;
   k.text = k.bounce ? "a bounce run (experiment.kind = \"bounce\")"
            : k.mesh ? "a mesh body (body.kind = \"mesh\")"
@@ -271,7 +286,7 @@ void apply_body_options(Scene& scene, const RawOptions& r, const Given& given) {
   }
 }
 
-void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
   const std::string& mode = r.mode;
   e.mode = parse_mode(mode);
@@ -289,7 +304,7 @@ void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, co
 }
 
 // --drops, --mode, --spheres, --seed: the design of the ensemble.
-void apply_design_options(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+void apply_design_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
   if (given("--drops")) {
     e.drops = parse_count("--drops", r.drops, 1, kMaxStreamingDrops);  // > 2^31: streaming only (validate)
@@ -309,7 +324,7 @@ void apply_design_options(Scene& scene, const RawOptions& r, const Given& given,
 }
 
 // --speed, --omega-x, --omega-y: the impact (a mesh body's bounce takes the spin as its start).
-void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
   if (given("--speed")) {
     const double u = parse_positive("--speed", r.speed, "m/s");
@@ -333,7 +348,7 @@ void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given,
     refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
 }
 
-void apply_backend_option(Scene& scene, const RawOptions& r, const RunKind& k) {
+void apply_backend_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
   auto& e = scene.ensemble;
   e.backend = parse_backend(r.backend);
   scene.backend_auto = false;
@@ -433,7 +448,7 @@ TangentialLaw parse_tangential(const std::string& text) {
   return law;
 }
 
-void apply_tangential_option(Scene& scene, const RawOptions& r, const RunKind& k) {
+void apply_tangential_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
   const TangentialLaw law = parse_tangential(r.tangential);
   if (k.radii) refuse("--tangential", k.text + " is analysed as contacts only (no impacts)");
   auto& x = scene.ensemble.impact;
@@ -446,7 +461,7 @@ void apply_tangential_option(Scene& scene, const RawOptions& r, const RunKind& k
 }
 
 // --statistics, --bins-log2 (sphere contact runs), --checkpoint-every (streaming runs).
-void apply_streaming_options(Scene& scene, const RawOptions& r, const Given& given, const RunKind& k) {
+void apply_streaming_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
   if (given("--checkpoint-every")) {
     scene.checkpoint_seconds = parse_real("--checkpoint-every", r.checkpoint_every);
@@ -457,6 +472,17 @@ void apply_streaming_options(Scene& scene, const RawOptions& r, const Given& giv
   if (given("--bins-log2")) e.bins_log2 = static_cast<unsigned>(parse_count("--bins-log2", r.bins_log2, 10, 24));
   if ((given("--statistics") || given("--bins-log2")) && (k.bounce || k.mesh || k.radii))
     refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
+}
+
+// --checkpoint-every and --bins-log2 act on streaming statistics only: on a run that keeps raw
+// samples (as planned: statistics auto streams above 2^25 drops without impacts) they would be
+// silently ignored, so they are refused. Checked on the validated scene, after every option.
+void refuse_unused_streaming_options(const Scene& scene, const Given& given) {
+  if (!given("--checkpoint-every") && !given("--bins-log2")) return;
+  if (run_kind(scene) == RunKind::sphere && uses_streaming(make_plan(scene).scene.ensemble)) return;
+  refuse(given("--checkpoint-every") ? "--checkpoint-every" : "--bins-log2",
+         "acts on streaming statistics only, and this run keeps raw samples (give --statistics streaming, or leave "
+         "the option out)");
 }
 
 // --resume DIR: the checkpoint's own scene; only options that change no result may come with it.
@@ -503,7 +529,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   Scene scene = !given("--scene") && !given("--resume") ? preset(r.preset_name) : load ? load(path) : load_scene(path);
   if (given("--resume")) scene.out = r.resume, scene.resume = true;
   apply_body_options(scene, r, given);
-  const RunKind k = run_kind(scene);
+  const OptionKind k = option_kind(scene);
   apply_design_options(scene, r, given, k);
   apply_impact_options(scene, r, given, k);
   if (given("--backend")) apply_backend_option(scene, r, k);
@@ -512,6 +538,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   apply_streaming_options(scene, r, given, k);
   apply_run_options(scene, r, given);
   validate(scene);
+  refuse_unused_streaming_options(scene, given);
   return scene;
 }
 
