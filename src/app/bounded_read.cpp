@@ -39,6 +39,7 @@ int open_checked(const std::filesystem::path& file, std::uint64_t max_bytes, con
   if (fd < 0) {
     const int err = errno;
     if (err == ELOOP) refuse(what, file, "a symbolic link that loops or nests too deeply");
+    if (err == ENOENT) refuse(what, file, "does not exist");
     refuse(what, file, "cannot open: " + reason(err));
   }
   Fd guard{fd};

@@ -94,7 +94,7 @@ TEST(SceneBounds, OnlyRegularFilesAreRead) {
                                   {d / "fifo.toml", "not a regular file"},
                                   {d, "is a directory"},
                                   {d / "loop.toml", "symbolic link that loops"},
-                                  {d / "missing.toml", "cannot open"}}) {
+                                  {d / "missing.toml", "does not exist"}}) {
     const std::string m = message_of([&] { load_scene(file); });
     EXPECT_NE(m.find(why), std::string::npos) << file << ": " << m;
     EXPECT_NE(m.find(file.string()), std::string::npos) << "the message names the file: " << m;
