@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
+# `pip install .` as docs/install.md gives it, offline: a venv with Debian's site packages (numpy),
+# --no-build-isolation, into a temporary directory; then, from outside the source tree, the
+# installed package imports, states the project's version, and ships its stubs and py.typed.
+# Arguments: PYTHON SOURCE_DIR BUILD_DIR (an already built tree: setup.py reuses it, so this test
+# checks the packaging, not a second build of the library).
+set -euo pipefail
+python=$1 src=$2 build=$3
+work=$(mktemp -d "${TMPDIR:-/tmp}/asperity-pip.XXXXXX")
+trap 'rm -rf "$work"' EXIT
+"$python" -m venv --system-site-packages "$work/venv"
+ASPERITY_BUILD_DIR="$build" "$work/venv/bin/pip" install --no-build-isolation --no-deps --no-index -q "$src" \
+  > "$work/pip.log" 2>&1 || { cat "$work/pip.log"; exit 1; }
+want=$(sed -n 's/^project(asperity VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")
+cd "$work"  # not the source tree: the import must find the installed package
+PYTHONPATH= "$work/venv/bin/python" - "$want" "$work/venv" <<'PY'
+import pathlib, sys
+import asperity
+want, venv = sys.argv[1], pathlib.Path(sys.argv[2]).resolve()
+pkg = pathlib.Path(asperity.__file__).resolve().parent
+assert venv in pkg.parents, f"imported {pkg}, not the venv's package"
+assert asperity.__version__ == want, (asperity.__version__, want)
+for f in ("_asperity.pyi", "__init__.pyi", "py.typed"):
+    assert (pkg / f).is_file(), f"{f} missing from {pkg}"
+libs = sorted(p.name for p in pkg.glob("libasperity_*.so*"))
+assert libs, f"no asperity libraries beside the module in {pkg}"
+assert asperity.eq14_rxy(1000, 1e-3).name, "a binding call"
+print(f"pip install: asperity {asperity.__version__} from {pkg} with {', '.join(libs)}")
+PY
+shown=$("$work/venv/bin/pip" show asperity)
+grep -qx "Version: $want" <<<"$shown" || { echo "pip show: $shown"; exit 1; }
