@@ -2,6 +2,8 @@
 /* A DEM code's view of a restitution table: this file is built against include/asperity/cor_table.h
  * alone (C99, no asperity library linked). Without arguments it checks the sampler on a small table
  * written here; with a path it also loads that table (one asperity wrote) and checks its shape. */
+/* A smaller bound than the default 1 GiB, so that the test can write a file over it. */
+#define ASPERITY_COR_MAX_BYTES 65536L
 #include "asperity/cor_table.h"
 
 #include <math.h>
@@ -230,7 +232,34 @@ static void check_files(void) {
   CHECK(asperity_cor_load(&t, ".", err, sizeof err) == -1 && strstr(err, "not a regular file"));
   CHECK(asperity_cor_load(&t, "/dev/zero", err, sizeof err) == -1 && strstr(err, "not a regular file"));
   CHECK(asperity_cor_load(&t, "/dev/null", err, sizeof err) == -1 && strstr(err, "not a regular file"));
+  /* a FIFO with no writer: refused at once, not waited on */
+  remove("test_cor_table_c.tmp.fifo");
+  if (mkfifo("test_cor_table_c.tmp.fifo", 0600) == 0) {
+    CHECK(asperity_cor_load(&t, "test_cor_table_c.tmp.fifo", err, sizeof err) == -1 && strstr(err, "not a regular file"));
+    remove("test_cor_table_c.tmp.fifo");
+  }
 #endif
+  /* a file of exactly the table but without its final line end: refused (a cut table) */
+  f = fopen(path, "wb");
+  if (f) {
+    fwrite(kTable, 1, strlen(kTable) - 1, f);
+    fclose(f);
+  }
+  CHECK(asperity_cor_load(&t, path, err, sizeof err) == -1 && strstr(err, "line 5: ") && strstr(err, "line end"));
+  /* a valid table padded with comments past ASPERITY_COR_MAX_BYTES: refused before parsing */
+  f = fopen(path, "wb");
+  if (f) {
+    int i;
+    fputs(kTable, f);
+    for (i = 0; i < 1200; ++i) /* 1200 x 58 bytes > 65536 */ fputs("# padding padding padding padding padding padding padding\n", f);
+    fclose(f);
+  }
+  if (asperity_cor_load(&t, path, err, sizeof err) == 0) {
+    asperity_cor_free(&t);
+    CHECK(!"a file over ASPERITY_COR_MAX_BYTES was read");
+  }
+  CHECK(strstr(err, "larger than ASPERITY_COR_MAX_BYTES") != NULL);
+  remove(path);
 }
 
 /* ---- Contact models: one two-body head-on impact integrated directly, the drawn eps recovered ----
