@@ -134,6 +134,7 @@ typedef struct asperity_cor__parser {
   long spins, speeds, probs, bands; /* counts stated on line 1 (-1: not stated) */
   long rows;                 /* data rows read */
   size_t n_e, n_o;           /* values stored in eps and omega */
+  const char *point;         /* the C locale's decimal point, which strtod reads */
 } asperity_cor__parser;
 
 static inline void asperity_cor__error(char *err, size_t n, const char *what, long line, const char *tok,
@@ -180,8 +181,7 @@ static inline const char *asperity_cor__number(asperity_cor__parser *p, const ch
   char *e;
   size_t n = 0, k, pl;
   int digits = 0, nonzero = 0;
-  const struct lconv *lc = localeconv();
-  const char *point = (lc && lc->decimal_point && lc->decimal_point[0]) ? lc->decimal_point : ".";
+  const char *point = p->point;
   p->tok = c, p->tok_end = asperity_cor__tok_end(c, end);
   if (c == end || *c == ',') return "empty value (a row ending in ',', or ',,')";
   if (d < end && (*d == '+' || *d == '-')) ++d;
@@ -423,9 +423,11 @@ static inline int asperity_cor_parse(asperity_cor_table *t, const char *text, ch
   const size_t text_len = strlen(text);
   int header = 0;
   asperity_cor__parser p;
+  const struct lconv *lc = localeconv();
   memset(t, 0, sizeof *t);
   memset(&p, 0, sizeof p);
   p.t = t;
+  p.point = (lc && lc->decimal_point && lc->decimal_point[0]) ? lc->decimal_point : ".";
   p.spins = p.speeds = p.probs = p.bands = -1;
   while (*s && !why) {
     const char *nl = strchr(s, '\n');
