@@ -34,6 +34,13 @@ void check_samples(const asperity_cor_table& t) {
         if (!std::isfinite(e)) fail("a sample is not finite");
         if (e < prev) fail("samples decrease in u");
         prev = e;
+        if (e >= 0.0 && e <= 1.0) {  // the contact-model conversions of a drawn eps, and back
+          const double g = asperity_cor_linear_gamma(e, 1e5, 2e-3), a = asperity_cor_tsuji_alpha(e);
+          if (!(g >= 0.0 && g <= 2.0 * std::sqrt(2e2) * (1.0 + 1e-15)) || !(a >= 0.0 && a <= std::sqrt(5.0) * (1.0 + 1e-15)))
+            fail("a conversion left its range");
+          if (std::abs(asperity_cor_linear_eps(g, 1e5, 2e-3) - e) > 1e-9 || std::abs(asperity_cor_tsuji_eps(a) - e) > 1e-9)
+            fail("a conversion does not invert");
+        }
         const double w = asperity_cor_sample_omega(&t, spin, speed, u, 1.0 - u);
         if (t.n_bands > 0 ? !std::isfinite(w) : !std::isnan(w)) fail("omega sample");
       }
@@ -113,7 +120,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (t.n_speeds < 1 || t.n_probs < 2 || t.n_spins < 1 || !t.eps || !t.speeds || !t.probs || !t.spins) fail("accepted a malformed table");
   if ((t.n_bands > 0) != (t.omega != nullptr)) fail("bands without omega rows");
   check_samples(t);
-  check_exact(text, t);
+  check_exact(std::string(text.c_str()), t);  // what the parser saw: the text up to its first NUL
   asperity_cor_free(&t);
   return 0;
 }
