@@ -14,6 +14,7 @@
 #include "asperity/app/atomic_file.hpp"
 #include "asperity/config.hpp"
 #include "asperity/core/restitution.hpp"
+#include "asperity/cor_table.h"
 #include "asperity/laws/statistics.hpp"
 
 namespace asperity {
@@ -191,7 +192,23 @@ void write_quantiles(std::ostream& o, const std::vector<double>& q) {
 std::string cor_table_csv(const CorTable& t) {
   std::ostringstream o;
   const int format = t.format();
-  o << "# asperity-cor-table format=" << format << "\n";
+  // Line 1 states the counts, so a reader can refuse a table that lost rows or blocks
+  // (include/asperity/cor_table.h, "THE FORMAT"); the values must lie in the ranges it states.
+  const std::size_t speeds = t.spec.speeds.size(), spins = speeds ? t.rows.size() / speeds : 0;
+  const std::size_t bands = t.rows.empty() ? 0 : t.rows.front().omega_x_band_quantiles.size();
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const auto& r = t.rows[i];
+    for (const double e : r.quantiles)
+      if (!(e >= 0.0 && e <= ASPERITY_COR_EPS_MAX)) bad("rows[" + std::to_string(i) + "] eps", num(e), "outside [0, 1000]: not a restitution table");
+    for (const auto& q : r.omega_x_band_quantiles)
+      for (const double w : q)
+        if (!(std::abs(w) <= ASPERITY_COR_OMEGA_MAX)) bad("rows[" + std::to_string(i) + "] Omega'_x", num(w), "outside [-1e15, 1e15] rad/s");
+    if (r.omega_x_band_quantiles.size() != bands) bad("omega_bands", std::to_string(bands), "differs between rows");
+  }
+  o << "# asperity-cor-table format=" << format;
+  if (format == 1) o << " speeds=" << t.rows.size() << " probabilities=" << t.probabilities.size() << "\n";
+  else
+    o << " spins=" << spins << " speeds=" << speeds << " probabilities=" << t.probabilities.size() << " bands=" << bands << "\n";
   if (format == 1)
     o << "# eps quantiles: row = impact speed [m/s], column p = probability; sample eps by bilinear\n"
       << "# interpolation in (speed, p) with a uniform u (include/asperity/cor_table.h). Header: the .json file.\n";

@@ -76,6 +76,14 @@ TEST(CorTable, TheCHeaderReadsTheCsvAndSamplesItsNodes) {
       EXPECT_EQ(asperity_cor_sample(&c, t.rows[i].speed, t.probabilities[j]), t.rows[i].quantiles[j]);
     }
   asperity_cor_free(&c);
+  // Line 1 states the counts the reader checks: the written table loses its last row -> refused.
+  const std::string csv = cor_table_csv(t);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "# asperity-cor-table format=1 speeds=3 probabilities=21");
+  const std::string cut = csv.substr(0, csv.rfind('\n', csv.size() - 2) + 1);
+  ASSERT_EQ(asperity_cor_parse(&c, csv.c_str(), err, sizeof err), 0) << err;
+  asperity_cor_free(&c);
+  ASSERT_EQ(asperity_cor_parse(&c, cut.c_str(), err, sizeof err), -1);
+  EXPECT_NE(std::string(err).find("ends early"), std::string::npos) << err;
   std::filesystem::remove_all(dir);
 }
 
