@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstdlib>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
@@ -110,10 +111,11 @@ void wait_for_creations(Slots& slots, long self, int& budget_ms) {
 
 bool live(const Slot& s) { return s.state.load() == kRegistered || s.state.load() == kCreating; }
 
-[[noreturn]] void clean_up_and_exit(int sig) {
-  // Called from a handler, or from ~InterruptDeferral in normal context: there a second signal
-  // (SIGPIPE from the message below on a closed pipe) would enter on_signal, find the phase taken
-  // and pause this thread forever. Blocked here, it waits; other threads that take it pause.
+// Kills the registered children and removes the registered paths (async-signal-safe).
+void remove_registered() {
+  // Called from a handler, or in normal context (~InterruptDeferral, an unexpected exit): there a
+  // second signal (SIGPIPE from a message on a closed pipe) would enter on_signal, find the phase
+  // taken and pause this thread forever. Blocked here, it waits; other threads that take it pause.
   sigset_t all;
   sigemptyset(&all);
   for (int s : kSignals) sigaddset(&all, s);
@@ -138,6 +140,10 @@ bool live(const Slot& s) { return s.state.load() == kRegistered || s.state.load(
   for (int pass = 0; pass < 2; ++pass)
     for (int i = kSlots - 1; i >= 0; --i)
       if (live(g_slots[i]) && g_slots[i].kind == Kind::empty_directory) ::rmdir(g_slots[i].path);
+}
+
+[[noreturn]] void clean_up_and_exit(int sig) {
+  remove_registered();
   put(g_program);
   put(": interrupted by ");
   put(signal_name(sig));
@@ -148,6 +154,23 @@ bool live(const Slot& s) { return s.state.load() == kRegistered || s.state.load(
 
 [[noreturn]] void wait_for_exit() {
   for (;;) ::pause();
+}
+
+std::atomic<bool> g_normal_exit{false};
+
+// atexit: a library that ends the process with exit() -- libgomp when it cannot create a thread
+// exits 1, which is our "a law was rejected" -- must neither claim a verdict nor leave the staging
+// directory: its temporaries go as on a signal, and the status is 2 (failure).
+void on_unexpected_exit() {
+  if (g_normal_exit.load()) return;
+  int expected = 0;
+  if (!g_phase.compare_exchange_strong(expected, 2)) return;  // a signal is being handled
+  remove_registered();
+  put(g_program);
+  put(g_committed.load() ? ": error: ended by a library (see its message above) after the run had completed\n"
+                         : ": error: ended by a library (see its message above); this run's temporary files were "
+                           "removed, the output directory is as it was\n");
+  ::_exit(2);
 }
 
 void on_signal(int sig) {
@@ -166,6 +189,7 @@ void on_signal(int sig) {
 void install_interrupt_cleanup(const char* program) {
   if (g_installed.exchange(true)) return;
   g_program = program;
+  std::atexit(on_unexpected_exit);
   struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
@@ -236,6 +260,7 @@ InterruptChild::~InterruptChild() {
 }
 
 void set_interrupt_output_committed() { g_committed.store(true); }
+void mark_normal_exit() { g_normal_exit.store(true); }
 
 int interrupt_pending() { return g_pending.load(); }
 bool interrupt_cleanup_installed() { return g_installed.load(); }

@@ -25,7 +25,10 @@
 namespace fs = std::filesystem;
 using namespace asperity;
 using asperity::testing::fresh_dir;
-using asperity::testing::run_command;
+// The shell command with `env` (VAR=value ...) set for it alone.
+asperity::testing::CommandResult run_command(const std::string& cmd, const std::string& env = "") {
+  return asperity::testing::run_command(env.empty() ? cmd : "export " + env + "; " + cmd);
+}
 
 namespace {
 
@@ -194,6 +197,12 @@ TEST(CliBounds, RefusalsNameTheOption) {
     EXPECT_NE(r.out.find(c.says), std::string::npos) << c.args << ": " << r.out;
   }
   EXPECT_TRUE(fs::is_empty(d)) << "a refused run writes nothing";
+  // A library that ends the process: libgomp exits 1 ("a law was rejected") when it cannot create
+  // a thread (here: a stack no mmap can give). The run must say failure (2) and leave nothing.
+  const auto t = run_command(in + "--threads 2 --drops 100000 --no-plots --quiet --out run 2>&1", "OMP_STACKSIZE=100G");
+  EXPECT_EQ(t.status, 2) << t.out;
+  EXPECT_NE(t.out.find("ended by a library"), std::string::npos) << t.out;
+  EXPECT_TRUE(fs::is_empty(d)) << "the staging directory and the created --out are removed";
   const auto v = run_command("'" + vg + "' --version");
   EXPECT_EQ(v.status, 0);
   EXPECT_EQ(v.out, std::string("validate-geometry ") + ASPERITY_VERSION + "\n");

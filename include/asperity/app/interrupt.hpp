@@ -51,6 +51,11 @@ class InterruptChild {
   int slot_ = -1;
 };
 
+/// From install_interrupt_cleanup on, an exit() that main did not choose (a library ending the
+/// process: libgomp exits 1 when it cannot create threads) removes the registered temporaries as a
+/// signal would and ends with status 2. main calls this just before it returns its own status.
+void mark_normal_exit();
+
 /// The run's files are in place (OutputStaging::commit): a later signal says so.
 void set_interrupt_output_committed();
 

@@ -195,7 +195,9 @@ int run_split(const Scene& scene, bool quiet, Collective& world) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run_main(int argc, char** argv) {
   // First, before any thread exists: SIGINT/SIGTERM/SIGHUP/SIGPIPE remove this run's temporaries
   // (its staging directory, gnuplot's files, the directories it created) and exit 128 + signal.
   install_interrupt_cleanup("validate-geometry");
@@ -233,4 +235,12 @@ int main(int argc, char** argv) {
   }
   if (world) return run_split(scene, quiet, *world);
   return run_reporting(scene, quiet, nullptr);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int status = run_main(argc, argv);
+  asperity::mark_normal_exit();  // any other exit() is a library's failure (interrupt.hpp)
+  return status;
 }
