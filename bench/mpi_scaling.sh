@@ -1,6 +1,6 @@
 #!/bin/bash
 # SPDX-License-Identifier: GPL-3.0-or-later
-# MPI scaling of a streaming run (README "Beyond one machine"): one process with 1 and 2 threads,
+# MPI scaling of a streaming run (docs/mpi.md): one process with 1 and 2 threads,
 # two processes with 1 thread each; wall of the whole command and each process's CPU and wall.
 # Usage: bench/mpi_scaling.sh [validate-geometry] (default build/release/validate-geometry)
 V=${1:-build/release/validate-geometry}

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The quenched deviation of one explicit sphere's law of r_xy from the ensemble law (kQuenchedKs,
-// experiments/ensemble.hpp; README "The explicit design"; bench/RESULTS.md). K explicit spheres of
+// experiments/ensemble.hpp; docs/science-default-run.md "The explicit design"; bench/RESULTS.md). K explicit spheres of
 // N asperities (grid query), M Haar-random rotations each, against the exact finite-N law F:
 //  - KS: D_k = sup |F_k - F| of sphere k's sample. With M large the statistical part (0.87/sqrt(M))
 //    is small, and c = sqrt(<D_k^2> - 0.87^2/M) sqrt(N) estimates E sup |F_sphere - F| sqrt(N)

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Figure of README "Bounces of rough bodies": eps and spin against impact speed for several bodies.
+"""Figure of docs/science-beyond.md "Bounces of rough bodies": eps and spin against impact speed for several bodies.
 
 Usage: scripts/plot_body_bounces.py OUT.png LABEL=report.json [LABEL=report.json ...]
 Each report.json is written by `rough_bodies bounce` or `validate-geometry` (body bounce runs:

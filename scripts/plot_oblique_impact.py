@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""Figure of README "Oblique impacts against published data": a 5 mm Al2O3 sphere on glass at 3.9 m/s.
+"""Figure of docs/science-beyond.md "Oblique impacts against published data": a 5 mm Al2O3 sphere on glass at 3.9 m/s.
 
 Usage: scripts/plot_oblique_impact.py [BUILD_DIR [OUT.png]]
        (defaults build/release and docs/figures/oblique-impact-kharaz.png)

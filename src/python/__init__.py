@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """asperity: explicit-geometry contacts and restitution statistics of rough particles.
 
-Thin bindings of the C++ library (README "Python"): asperity.run(scene) runs a scene as the CLI
+Thin bindings of the C++ library (docs/python.md): asperity.run(scene) runs a scene as the CLI
 validate-geometry does and returns report.json as a dict (with per-drop numpy arrays for small
 runs); the core pieces (rough spheres, contact queries, the impulse solve, eps_n models, the laws)
 work on numpy arrays; asperity.cor_table(...) writes restitution tables for DEM codes.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// The Python module asperity._asperity (README "Python"): thin bindings of the C++ library, one
+// The Python module asperity._asperity (docs/python.md): thin bindings of the C++ library, one
 // translation unit. No physics here: every number comes from the library; this file converts
 // arguments (numpy arrays, dicts, callables) and results, releases the GIL while the library
 // computes, and turns Ctrl-C into KeyboardInterrupt through the progress path.
@@ -678,7 +678,7 @@ void bind_tables(py::module_& m) {
       py::arg("scene") = "fig4", py::arg("speeds") = py::none(), py::arg("probabilities") = 201, py::arg("drops") = py::none(),
       py::arg("path") = py::none(), py::arg("progress") = py::none(), py::arg("spins") = py::none(),
       py::arg("omega_bands") = 0,
-      R"doc(A restitution table for DEM codes (app/cor_table.hpp; README "Restitution tables").
+      R"doc(A restitution table for DEM codes (app/cor_table.hpp; docs/dem-tables.md).
 
 The sphere, material, spin and seed come from `scene` (a sphere impact scene); speeds [m/s]
 default to 9 points from u/10 to 10 u around its impact speed u; drops per speed (sampled from the exact law of the lowest asperity)

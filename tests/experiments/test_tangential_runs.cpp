@@ -177,7 +177,7 @@ TEST(TangentialRuns, StrongeNeverGainsEnergyWaltonDoesOnAnEllipsoid) {
 
 TEST(TangentialRuns, StrongeBounceSequencesNeverGainEnergyTheKinematicLawDoes) {
   // 40 sequences of rough ellipsoids from 1 m/s: the kinematic law gains energy in a third of the
-  // impacts (README "Bounces of rough bodies"), Stronge's law in none.
+  // impacts (docs/science-beyond.md "Bounces of rough bodies"), Stronge's law in none.
   const TriangleMesh mesh = read_mesh(kMeshes / "ellipsoid.off");
   std::vector<RoughBody> bodies;
   for (std::uint64_t k = 0; k < 2; ++k)

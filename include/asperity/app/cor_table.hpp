@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-// Restitution tables for DEM codes (README "Restitution tables"): the distribution of the
+// Restitution tables for DEM codes (docs/dem-tables.md): the distribution of the
 // macroscopic restitution coefficient eps of the paper's rough sphere, as quantiles on a fine
 // probability grid for each impact speed of a speed grid. A DEM contact model samples it with its
 // own uniform u (include/asperity/cor_table.h: asperity_cor_sample, bilinear in speed and
@@ -87,7 +87,7 @@ struct CorTable {
 /// spin) at each (spin, speed) and records the quantiles of eps. Progress counts drops over all.
 CorTable make_cor_table(const CorTableSpec& spec, const Progress& progress = {});
 
-/// The CSV text (README "Restitution tables"): '#' comment lines, a header row
+/// The CSV text (docs/dem-tables.md): '#' comment lines, a header row
 /// "speed_m_s,p=<p0>,p=<p1>,...", then one row per speed; numbers in their shortest round-trip form.
 std::string cor_table_csv(const CorTable& t);
 /// The JSON header text.

@@ -92,7 +92,7 @@ std::string format_table(const GeometryReport& r);
 /// Serialised report.json text.
 std::string to_json(const GeometryReport& r);
 
-/// The fields every report.json has, whatever kind of run wrote it (README "report.json").
+/// The fields every report.json has, whatever kind of run wrote it (docs/report-json.md).
 struct ReportHeader {
   std::string tool = "validate-geometry";
   std::string scene;                    ///< scene name ("+custom" when the command line overrode it)

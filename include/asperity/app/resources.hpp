@@ -15,7 +15,7 @@ struct MemoryEstimate {
 };
 
 /// The estimated peak RSS of running `s` as validate-geometry does (no plots: gnuplot is a child
-/// process). Costs measured on x86-64 (README "validate-geometry", Memory); within 25 % of the measured peak for
+/// process). Costs measured on x86-64 (docs/cli.md, Memory); within 25 % of the measured peak for
 /// runs whose variable part dominates (tests/app/test_resources.cpp).
 MemoryEstimate estimate_memory(const Scene& s);
 

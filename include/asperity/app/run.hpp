@@ -29,7 +29,7 @@ GeometryReport run_scene(const Scene& s, const Progress& progress = {}, const st
 /// surface speed). Throws std::invalid_argument naming the key. Touches no output.
 void check_scene_inputs(const Scene& s);
 
-/// The kinds of run a scene can be (README "Scenes").
+/// The kinds of run a scene can be (docs/scenes.md).
 enum class RunKind {
   sphere,  ///< the paper's sphere: contacts and single impacts (run_scene)
   radii,   ///< unequal asperity radii on a sphere (run_radii_experiment)
@@ -48,7 +48,7 @@ struct SceneOutput {
   std::vector<std::string> files;   ///< files the run wrote (figures, PLY), by name
   bool rejected = false;            ///< a decisive test rejected its law (exit status 1)
   /// Decisive tests that could not be evaluated (verdict "skipped"), one line each with the
-  /// reason; the run still exits 0 unless a law was rejected (README "validate-geometry").
+  /// reason; the run still exits 0 unless a law was rejected (docs/cli.md).
   std::vector<std::string> skipped;
 };
 

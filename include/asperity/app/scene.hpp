@@ -2,7 +2,7 @@
 #pragma once
 // A scene: everything one run of validate-geometry needs, with named presets that reproduce the
 // paper's figures. Every field is validated before any work starts. Scenes are written as TOML
-// files (see scene_file.hpp and README "Scenes"); the presets are such files, embedded in the
+// files (see scene_file.hpp and docs/scenes.md); the presets are such files, embedded in the
 // library at build time from scenes/*.toml.
 #include <cstdint>
 #include <filesystem>

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Scene files: a versioned TOML format (format = 1) describing one run -- body, material,
-// asperities, ensemble, experiment, outputs. Documented in README "Scenes" and, key by key, in
+// asperities, ensemble, experiment, outputs. Documented in docs/scenes.md and, key by key, in
 // scenes/example.toml. Every key is checked: unknown keys, wrong types, NaN/inf and out-of-range
 // values are errors naming the full dotted key (and the value); features the engine does not have
 // yet (oblique impacts, constant restitution, ...) are errors

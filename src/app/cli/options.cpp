@@ -521,7 +521,7 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
     scene.name += "+custom";
 }
 
-// The preset or scene file, then the options over it (README "Scenes"), in this order: the kind of
+// The preset or scene file, then the options over it (docs/scenes.md), in this order: the kind of
 // run is taken after --asperity-radius, which can turn a radii run into the paper's.
 Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoader& load) {
   if (given("--resume")) check_resume_option(r, given);
