@@ -243,16 +243,18 @@ void write_checkpoint(const fs::path& dir, const Scene& s, const StreamState& st
   // and --resume). A scene file that was there belongs to the previous state, which has the same
   // key: still a complete pair.
   const bool had_scene = d.holds(kCheckpointScene);
-  if (scene) d.publish(*scene);
   try {
+    if (scene) d.publish(*scene);
     d.publish(state);
   } catch (...) {
-    if (scene && !had_scene) d.remove(kCheckpointScene);
+    if (scene && scene->published() && !had_scene && !state.published()) d.remove(kCheckpointScene);
     throw;
   }
 }
 
 std::string stream_state_bytes(const Scene& s, const StreamState& st) { return serialise(checkpoint_key(s), st); }
+
+std::uint64_t checkpoint_checksum(std::string_view bytes) { return crc64(bytes.data(), bytes.size()); }
 
 std::size_t checkpoint_state_size(const Scene& s) {
   const EnsembleConfig e = planned(s);

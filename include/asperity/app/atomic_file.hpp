@@ -33,6 +33,8 @@ class AtomicDirectory {
     Staged(Staged&&) noexcept;
     ~Staged();
     const std::string& name() const { return name_; }
+    /// Renamed into place (publish got that far, even if the directory's fsync then failed).
+    bool published() const { return temporary_.empty(); }
 
    private:
     friend class AtomicDirectory;

@@ -59,6 +59,10 @@ void check_checkpoint_files(const Scene& s);
 std::string stream_state_bytes(const Scene& s, const StreamState& st);
 StreamState stream_state_from_bytes(const std::string& bytes, const Scene& s, const std::string& what);
 
+/// The checksum a state file ends with (CRC-64/XZ of every byte before it): for tests that craft
+/// well-formed but inconsistent files.
+std::uint64_t checkpoint_checksum(std::string_view bytes);
+
 /// The size of every state file of scene s (the format has no optional parts).
 std::size_t checkpoint_state_size(const Scene& s);
 
