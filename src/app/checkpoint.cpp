@@ -197,11 +197,13 @@ std::string read_state_file(const fs::path& path, std::size_t size, const Scene&
   const auto have = static_cast<std::size_t>(st.st_size);
   std::string in(std::min(have, size), '\0');
   std::size_t got = 0;
-  for (ssize_t r; got < in.size(); got += static_cast<std::size_t>(r))
-    if ((r = ::read(fd, in.data() + got, in.size() - got)) <= 0) {
-      if (r < 0 && errno == EINTR) r = 0;
-      else throw std::invalid_argument(path.string() + ": damaged or truncated checkpoint (it shrank while being read)");
-    }
+  while (got < in.size()) {
+    const ssize_t r = ::read(fd, in.data() + got, in.size() - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) throw std::invalid_argument("cannot read " + path.string() + ": " + std::generic_category().message(errno));
+    if (r == 0) throw std::invalid_argument(path.string() + ": truncated checkpoint (it shrank while being read)");
+    got += static_cast<std::size_t>(r);
+  }
   if (have == size) return in;
   check_header(in, path.string(), dir);
   throw std::invalid_argument(path.string() + ": " + std::to_string(have) + " bytes, where a checkpoint of this scene has " +
