@@ -13,6 +13,9 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "asperity/app/atomic_file.hpp"
+#include "asperity/app/checkpoint.hpp"
+
 namespace asperity {
 
 namespace fs = std::filesystem;
@@ -40,6 +43,12 @@ std::string output_name_problem(std::string_view name) {
     if (u < 0x20 || u == 0x7f) return "contains a control character (NUL, newline, ...)";
   }
   if (name.substr(0, kStagingPrefix.size()) == kStagingPrefix) return "starts with the staging prefix " + std::string(kStagingPrefix);
+  if (name.substr(0, kTemporaryPrefix.size()) == kTemporaryPrefix)
+    return "starts with the prefix of temporary files " + std::string(kTemporaryPrefix);
+  // A streaming run writes, replaces and finally removes its checkpoint files in the output
+  // directory: an output of that name would be deleted by its own run, or clobber a checkpoint.
+  if (is_checkpoint_name(name))
+    return "is the name of a streaming run's checkpoint file (checkpoint.toml, checkpoint.bin, checkpoint.rank-R-of-P.bin)";
   return "";
 }
 

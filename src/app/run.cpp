@@ -370,19 +370,11 @@ std::string show(double v) {
 
 void check_scene_inputs(const Scene& s) {
   validate(s);
-  // A checkpoint in the output directory belongs to an interrupted streaming run: never overwritten.
-  const auto state = s.out / checkpoint_state_name(s.share);
-  const bool checkpoint = std::filesystem::exists(state);
   if (s.resume && !uses_streaming(s.ensemble))
     throw std::invalid_argument("--resume: the scene of " + s.out.string() + " does not stream (statistics = raw)");
-  if (s.resume && !checkpoint) read_checkpoint(s.out, s);  // throws, saying which process count wrote what
-  // checkpoint.toml too: this run's checkpoints would overwrite it (another process count's, or a
-  // run interrupted between its two files).
-  const auto scene_file = s.out / kCheckpointScene;
-  if (!s.resume && uses_streaming(s.ensemble) && (checkpoint || std::filesystem::exists(scene_file)))
-    throw std::invalid_argument("--out: " + (checkpoint ? state : scene_file).string() +
-                                " is the checkpoint of an interrupted run: continue it with --resume " + s.out.string() +
-                                ", or remove it");
+  // A checkpoint in the output directory belongs to an interrupted streaming run: never
+  // overwritten; a resumed run's is read whole now, before any file is touched.
+  check_checkpoint_files(s);
   if (!s.mesh) return;
   const auto& m = *s.mesh;
   TriangleMesh mesh;

@@ -293,15 +293,97 @@ void merge_shares(StreamState& into, const StreamState& o) {
   into.index_bytes = std::max(into.index_bytes, o.index_bytes);
 }
 
-StreamState initial_stream_state(const EnsembleConfig& c) {
+namespace {
+
+// The references of kStreamQuantities (Eq. 14's Rayleigh, Eq. 18's normal twice) and the blocks.
+struct Shape {
+  std::vector<Reference> refs;
+  std::size_t G;
+};
+Shape shape(const EnsembleConfig& c) {
   const double sigma = 1.0 / std::sqrt(2.0 * std::numbers::pi * areal_density(c.sphere.asperities, c.sphere.radius));
   const std::uint64_t K = c.mode == Mode::sampled ? c.drops : c.spheres;
-  const std::size_t G = static_cast<std::size_t>(std::min<std::uint64_t>(K, kStreamBlocks));
-  StreamState s;
-  s.stats.push_back(make_binned({Reference::Kind::rayleigh, sigma}, G, c.bins_log2, kStreamCoarseLog2));
-  for (int i = 0; i < 2; ++i)
-    s.stats.push_back(make_binned({Reference::Kind::normal, sigma}, G, c.bins_log2, kStreamCoarseLog2));
+  return {{{Reference::Kind::rayleigh, sigma}, {Reference::Kind::normal, sigma}, {Reference::Kind::normal, sigma}},
+          static_cast<std::size_t>(std::min<std::uint64_t>(K, kStreamBlocks))};
+}
+
+// Drops of spheres [a, b) done once units [u0, u1) are (u0 at a sphere's start): the whole spheres
+// and the units of the sphere in progress (4096 rotations each; it has more than that left).
+std::uint64_t drops_done(const Layout& l, std::uint64_t a, std::uint64_t b, std::uint64_t u0, std::uint64_t u1) {
+  const std::uint64_t lo = std::max(a, u0 / l.us), whole_end = std::min(b, u1 / l.us), k = u1 / l.us;
+  std::uint64_t n = whole_end > lo ? (whole_end - lo) * l.m : 0;
+  if (u1 % l.us != 0 && k >= lo && k < b) n += (u1 % l.us) * kUnit;
+  return n;
+}
+
+// The layout of initial_stream_state(c), compared without allocating one.
+std::string layout_problem(const EnsembleConfig& c, const StreamState& st) {
+  const Shape sh = shape(c);
+  if (st.stats.size() != sh.refs.size()) return "it holds " + std::to_string(st.stats.size()) + " quantities, not 3";
+  for (std::size_t q = 0; q < sh.refs.size(); ++q) {
+    const BinnedStats& b = st.stats[q];
+    if (b.ref != sh.refs[q] || b.fine_log2 != c.bins_log2 || b.coarse_log2 != kStreamCoarseLog2 || b.blocks != sh.G ||
+        b.fine.size() != b.fine_bins() || b.coarse.size() != sh.G * b.coarse_bins() || b.block_moments.size() != sh.G)
+      return "the histograms of " + kStreamQuantities[q] + " do not have this run's layout";
+  }
+  return "";
+}
+
+// Block g's moments of quantity q: its count is the drops done, its mean and spread within reach
+// of a contact point (|r| <= R + a).
+std::string moments_problem(const EnsembleConfig& c, std::size_t q, std::size_t g, const Moments& m, std::uint64_t n) {
+  const double reach = 1.01 * (c.sphere.radius + c.sphere.asperity_radius);
+  const std::string where = kStreamQuantities[q] + " block " + std::to_string(g);
+  if (m.n != n) return where + " counts " + std::to_string(m.n) + " drops in its moments, not " + std::to_string(n);
+  if (n == 0 && (m.mean != 0 || m.m2 != 0)) return where + " has moments but no drops";
+  if (!(std::abs(m.mean) <= reach && m.m2 >= 0 && m.m2 <= double(n) * 4 * reach * reach))
+    return where + " has moments out of range (mean " + std::to_string(m.mean) + ", m2 " + std::to_string(m.m2) + ")";
+  return "";
+}
+
+// The sum of n counts; all ones on overflow (no run counts that many drops), so that wrapped
+// counts never pass for the right total.
+std::uint64_t sum(const std::uint64_t* p, std::size_t n) {
+  std::uint64_t s = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (__builtin_add_overflow(s, p[i], &s)) return ~std::uint64_t{0};
   return s;
+}
+
+}  // namespace
+
+StreamState initial_stream_state(const EnsembleConfig& c) {
+  const Shape sh = shape(c);
+  StreamState s;
+  for (const Reference& ref : sh.refs) s.stats.push_back(make_binned(ref, sh.G, c.bins_log2, kStreamCoarseLog2));
+  return s;
+}
+
+std::string stream_state_problem(const EnsembleConfig& c, const StreamShare& share, const StreamState& st) {
+  if (std::string why = layout_problem(c, st); !why.empty()) return why;
+  const Layout l = layout(c);
+  const auto [u0, u1] = share_units(c, share);
+  if (st.next_unit < u0 || st.next_unit > u1)
+    return "its next unit " + std::to_string(st.next_unit) + " lies outside this process's share [" + std::to_string(u0) +
+           ", " + std::to_string(u1) + "]";
+  const std::uint64_t G = st.stats[0].blocks, C = st.stats[0].coarse_bins();
+  const std::uint64_t drops = drops_done(l, 0, l.K, u0, st.next_unit);
+  for (std::size_t q = 0; q < kQ; ++q) {
+    const BinnedStats& b = st.stats[q];
+    if (sum(b.fine.data(), b.fine.size()) != drops)
+      return "the fine histogram of " + kStreamQuantities[q] + " does not count the " + std::to_string(drops) + " drops done";
+    for (std::uint64_t g = 0; g < G; ++g) {
+      const std::uint64_t n = drops_done(l, (g * l.K + G - 1) / G, ((g + 1) * l.K + G - 1) / G, u0, st.next_unit);
+      if (sum(b.coarse.data() + g * C, C) != n)
+        return "block " + std::to_string(g) + " of " + kStreamQuantities[q] + " does not count its " + std::to_string(n) + " drops";
+      if (std::string why = moments_problem(c, q, g, b.block_moments[g], n); !why.empty()) return why;
+    }
+  }
+  const std::uint64_t started = (st.next_unit - u0 + l.us - 1) / l.us;  // spheres begun (each checked at its start)
+  if (st.core_contacts > drops) return "it counts more core contacts than drops";
+  if (st.check_agreed > st.check_queries || st.check_queries > started * l.m) return "its cross-check counts are impossible";
+  if (st.index_bytes > (std::uint64_t{1} << 50)) return "its index size is impossible";
+  return "";
 }
 
 ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progress, const StreamHooks& hooks,

@@ -32,11 +32,11 @@ const std::string kMpirun = std::string(MPIEXEC) + " --allow-run-as-root --overs
 
 fs::path fresh_dir(const std::string& name) { return asperity::testing::fresh_dir("mpi", name); }
 
-// 8e6 explicit drops at N = 10^3 (20000 spheres x 400 rotations, 256 blocks): ~16 waves of <= 2^18
-// drops per process, so that a SIGTERM sent once both processes wrote their first checkpoint finds
-// them running (with 2e6 drops, 4 waves, the faster drop loop of 2026-11-24 sometimes finished first).
+// 8e6 explicit drops at N = 10^3, spheres "auto" (the default: 5000 spheres x 1600 rotations, 256
+// blocks; before issue 24 no such run could be resumed): ~16 waves of <= 2^18 drops per process,
+// so that a SIGTERM sent once both processes wrote their first checkpoint finds them running (with 2e6 drops, 4 waves, the faster drop loop of 2026-11-24 sometimes finished first).
 std::string run_args(const fs::path& out) {
-  return " -q --asperities 1000 --drops 8000000 --spheres 20000 --statistics streaming --no-plots --out " + out.string();
+  return " -q --asperities 1000 --drops 8000000 --statistics streaming --no-plots --out " + out.string();
 }
 
 }  // namespace
@@ -54,8 +54,8 @@ TEST(Mpi, TwoProcessesWriteTheReportOfOneAndResumeFromTheirCheckpoints) {
   // Interrupted: each process writes its share's checkpoint once SIGTERM reaches it through mpirun.
   const fs::path log = cut.string() + ".log";
   std::vector<std::string> args{"--allow-run-as-root", "--oversubscribe", "--mca", "btl", "self,vader", "-np", "2",
-                                VALIDATE_GEOMETRY, "-q", "--asperities", "1000", "--drops", "8000000", "--spheres",
-                                "20000", "--statistics", "streaming", "--no-plots", "--threads", "1",
+                                VALIDATE_GEOMETRY, "-q", "--asperities", "1000", "--drops", "8000000",
+                                "--statistics", "streaming", "--no-plots", "--threads", "1",
                                 "--checkpoint-every", "0.000001", "--out", cut.string()};
   const pid_t pid = asperity::testing::spawn_cli(MPIEXEC, args, log);
   const fs::path r0 = cut / "checkpoint.rank-0-of-2.bin", r1 = cut / "checkpoint.rank-1-of-2.bin";

@@ -17,8 +17,8 @@
 namespace asperity {
 
 /// Why an output name is not a plain file name ("" when it is one): empty, ".", "..", a '/',
-/// a control character (NUL, newline, ...), longer than 255 bytes, or a name that starts with
-/// the staging prefix.
+/// a control character (NUL, newline, ...), longer than 255 bytes, a name that starts with
+/// the staging or temporary prefix, or a checkpoint file's name (is_checkpoint_name).
 std::string output_name_problem(std::string_view name);
 
 class OutputStaging {

@@ -82,6 +82,13 @@ std::uint64_t share_drops(const EnsembleConfig& c, const StreamShare& share);
 /// one run own disjoint blocks, so the order of the calls does not change a bit.
 void merge_shares(StreamState& into, const StreamState& o);
 
+/// Why `st` cannot be the state of `c`'s run (its `share`) between waves, "" when it can: the
+/// layout of initial_stream_state(c); next_unit inside the share; every block's coarse cells and
+/// moments count exactly the drops of the units done, its moments finite and within a contact
+/// point's reach; the fine histograms count all of them; the counters no more than possible. A
+/// checkpoint (app/checkpoint.hpp) passes it before it is used.
+std::string stream_state_problem(const EnsembleConfig& c, const StreamShare& share, const StreamState& st);
+
 /// Runs (or continues from `resume`, a state of the same config and share) the ensemble of `c`, or
 /// its `share`, on the streaming path. Throws std::invalid_argument for an invalid config (validate)
 /// or an impact experiment, std::runtime_error when the cross-check disagrees (as
