@@ -38,7 +38,7 @@ inline bool key_less(double ka, std::uint32_t ia, double kb, std::uint32_t ib) n
 }
 
 /// The spatial structure behind a ContactQuery. Every backend gives the same answers bit for bit;
-/// they differ in build time, memory and query speed (README "Benchmarks").
+/// they differ in build time, memory and query speed (bench/ measures them).
 enum class Backend {
   brute,   ///< linear scan over all centres (the reference)
   kdtree,  ///< nanoflann kd-tree
