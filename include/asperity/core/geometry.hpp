@@ -16,7 +16,7 @@
 
 namespace asperity {
 
-/// A 3-vector of doubles: positions [m], velocities [m/s], unit directions [1], per context.
+/// A 3-vector of doubles: a position [m], velocity [m/s] or unit direction [1], as each use states.
 using Vec3 = Eigen::Vector3d;
 
 /// Asperity indices are 32-bit (Nearest::index, support queries): a body carries 1 .. 2^32-1

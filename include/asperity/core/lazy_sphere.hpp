@@ -65,7 +65,7 @@ struct LazyNearest {
 };
 
 /// A rough sphere of N uniform centres generated lazily (see the file's comment): the same sample
-/// as materialise() would give, at a cost of O(log N) cells per query. One per thread.
+/// as materialise() would give, generating only the cells a query cannot rule out. One per thread.
 class LazySphere {
  public:
   /// N >= 1 (< 2^32, indices are 32-bit) centres; throws std::invalid_argument otherwise.

@@ -37,7 +37,8 @@
 namespace asperity {
 
 /// The scene of the Sec. IV laws: one rough sphere hitting the plate at normal incidence with
-/// spin, the paper's viscoelastic eps_n(v) (Pade [1/4], restitution.hpp). Defaults: Fig. 5.
+/// spin, with the paper's viscoelastic eps_n(v) (Pade [1/4], restitution.hpp). Frame as in the
+/// file's comment; validate() checks it.
 struct ImpactScene {
   std::uint64_t asperities = 100000;  ///< N
   double radius = 3e-3;               ///< R [m]
