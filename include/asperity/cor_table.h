@@ -4,8 +4,11 @@
  * under any licence (GPL-2.0-only LAMMPS/LIGGGHTS, BSD) may include it. It depends on nothing but
  * the C standard library (and, on POSIX systems, <fcntl.h>, <sys/stat.h> and <unistd.h> to refuse
  * directories and special files), so including it brings in no GPL code. */
-/* asperity restitution tables for DEM codes: one self-contained C99 header (docs/dem-coupling.md).
- * Works from C and C++.
+/** \file
+ * asperity restitution tables for DEM codes: one self-contained C99 header (docs/dem-coupling.md).
+ * Works from C and C++. The format, the sampling rules and the contact-model relations follow
+ * (shown as written in the header).
+ * \verbatim
  *
  * A table (written by asperity.cor_table(...) in Python, outputs.cor_table in a scene, or
  * asperity::write_cor_table in C++) holds quantiles eps(speed_i, p_j) of the macroscopic restitution
@@ -84,7 +87,8 @@
  *     coeff_restitution" for Hertz; tests/c/test_cor_table.c checks it against a direct integration
  *     of the Hertz-Tsuji equation to 1e-6.) alpha >= sqrt(5): no rebound (eps = 0).
  * The functions return NAN outside their domain (eps > 1 cannot come from a passive dashpot: a host
- * that draws eps > 1 from a table with spin must decide itself, e.g. clamp to 1). */
+ * that draws eps > 1 from a table with spin must decide itself, e.g. clamp to 1).
+ * \endverbatim */
 #ifndef ASPERITY_COR_TABLE_H
 #define ASPERITY_COR_TABLE_H
 
@@ -104,27 +108,31 @@
 extern "C" {
 #endif
 
+/** A loaded restitution table: the grids and the quantiles, all owned by the table (free it with
+ * asperity_cor_free). asperity_cor_load and asperity_cor_parse overwrite every field (free a loaded
+ * table before loading another into it). Read-only after loading: any number of threads may sample
+ * it at once. */
 typedef struct asperity_cor_table {
-  int n_speeds;      /* speeds of the grid */
-  int n_probs;       /* columns of quantiles */
-  double *speeds;    /* [n_speeds], strictly ascending [m/s] */
-  double *probs;     /* [n_probs], strictly ascending, probs[0] = 0, probs[n_probs-1] = 1 */
-  double *eps;       /* [n_spins * n_speeds * n_probs]: eps[(k * n_speeds + i) * n_probs + j] */
-  int format;        /* 1 or 2 */
-  int n_spins;       /* 1 for format 1 (the spin in the table's comment and JSON header) */
-  double *spins;     /* [n_spins], strictly ascending [rad/s]; format 1: one entry, 0 */
-  int n_bands;       /* eps bands with Omega'_x quantiles; 0: none (always 0 in format 1) */
-  double *omega;     /* [((k * n_speeds + i) * n_bands + b) * n_probs + j] */
+  int n_speeds;      /**< speeds of the grid */
+  int n_probs;       /**< columns of quantiles */
+  double *speeds;    /**< [n_speeds], strictly ascending [m/s] */
+  double *probs;     /**< [n_probs], strictly ascending, probs[0] = 0, probs[n_probs-1] = 1 */
+  double *eps;       /**< [n_spins * n_speeds * n_probs]: eps[(k * n_speeds + i) * n_probs + j] */
+  int format;        /**< 1 or 2 */
+  int n_spins;       /**< 1 for format 1 (the spin in the table's comment and JSON header) */
+  double *spins;     /**< [n_spins], strictly ascending [rad/s]; format 1: one entry, 0 */
+  int n_bands;       /**< eps bands with Omega'_x quantiles; 0: none (always 0 in format 1) */
+  double *omega;     /**< [((k * n_speeds + i) * n_bands + b) * n_probs + j] */
 } asperity_cor_table;
 
-#define ASPERITY_COR_TABLE_FORMAT 2 /* the newest format this header reads (it reads 1 too) */
+#define ASPERITY_COR_TABLE_FORMAT 2 /**< the newest format this header reads (it reads 1 too) */
 #ifndef ASPERITY_COR_MAX_BYTES
-#define ASPERITY_COR_MAX_BYTES (1L << 30) /* the largest table file asperity_cor_load reads */
+#define ASPERITY_COR_MAX_BYTES (1L << 30) /**< the largest table file asperity_cor_load reads [bytes]; define it before including to change it */
 #endif
-#define ASPERITY_COR_EPS_MAX 1000.0
-#define ASPERITY_COR_SPEED_MAX 1e8
-#define ASPERITY_COR_SPIN_MAX 1e6
-#define ASPERITY_COR_OMEGA_MAX 1e15
+#define ASPERITY_COR_EPS_MAX 1000.0  /**< the largest eps a table may hold (a larger one is a damaged table) */
+#define ASPERITY_COR_SPEED_MAX 1e8   /**< the largest grid speed a table may hold [m/s] */
+#define ASPERITY_COR_SPIN_MAX 1e6    /**< the largest |spin| of a format-2 spin grid [rad/s] */
+#define ASPERITY_COR_OMEGA_MAX 1e15  /**< the largest |Omega'_x| quantile a table may hold [rad/s] */
 
 /* Parser state: the declared counts, where it is, and what the next message quotes. */
 typedef struct asperity_cor__parser {
@@ -155,7 +163,7 @@ static inline void asperity_cor__error(char *err, size_t n, const char *what, lo
   else snprintf(err, n, "%s", what);
 }
 
-/* Frees what asperity_cor_load allocated; the table is then empty. */
+/** Frees what asperity_cor_load allocated; the table is then empty. */
 static inline void asperity_cor_free(asperity_cor_table *t) {
   if (!t) return;
   free(t->speeds);
@@ -417,7 +425,7 @@ static inline const char *asperity_cor__row(asperity_cor__parser *p, const char 
   return why;
 }
 
-/* Parses the CSV text (NUL-terminated). Returns 0, or -1 with a message in err (may be NULL). */
+/** Parses the CSV text (NUL-terminated). Returns 0, or -1 with a message in err (may be NULL). */
 static inline int asperity_cor_parse(asperity_cor_table *t, const char *text, char *err, size_t err_size) {
   const char *s = text, *why = NULL;
   const size_t text_len = strlen(text);
@@ -465,7 +473,7 @@ static inline int asperity_cor_parse(asperity_cor_table *t, const char *text, ch
   return -1;
 }
 
-/* Reads and parses a table file. Returns 0, or -1 with a message in err (may be NULL). */
+/** Reads and parses a table file. Returns 0, or -1 with a message in err (may be NULL). */
 static inline int asperity_cor_load(asperity_cor_table *t, const char *path, char *err, size_t err_size) {
   char *text = NULL;
   size_t n = 0, cap = 0;
@@ -594,19 +602,19 @@ static inline double asperity_cor__interp(const asperity_cor_table *t, const dou
   return r;
 }
 
-/* eps for an impact at `speed` [m/s] with incoming spin `spin` [rad/s] and the host's uniform u in
+/** eps for an impact at `speed` [m/s] with incoming spin `spin` [rad/s] and the host's uniform u in
  * [0, 1]: trilinear in (spin, speed, p). Format 1 tables have one spin (the argument is ignored). */
 static inline double asperity_cor_sample_spin(const asperity_cor_table *t, double spin, double speed, double u) {
   return asperity_cor__interp(t, t->eps, (size_t)t->n_probs, spin, speed, asperity_cor__clamp01(u));
 }
 
-/* eps for an impact at `speed` [m/s] and the host's uniform u in [0, 1]: bilinear interpolation of
+/** eps for an impact at `speed` [m/s] and the host's uniform u in [0, 1]: bilinear interpolation of
  * the quantile table in (speed, p), at the table's first spin. */
 static inline double asperity_cor_sample(const asperity_cor_table *t, double speed, double u) {
   return asperity_cor_sample_spin(t, t->n_spins > 0 ? t->spins[0] : 0.0, speed, u);
 }
 
-/* Omega'_x [rad/s] after the impact whose eps was drawn with u: quantile u2 of Omega'_x among the
+/** Omega'_x [rad/s] after the impact whose eps was drawn with u: quantile u2 of Omega'_x among the
  * drops whose eps fell in the band of u, interpolated in (spin, speed, u2). NAN when the table has
  * no omega_x rows (format 1, or n_bands = 0). */
 static inline double asperity_cor_sample_omega(const asperity_cor_table *t, double spin, double speed, double u,
@@ -640,7 +648,7 @@ static inline double asperity_cor__ratio_of_eps(double eps) {
 
 static inline int asperity_cor__positive(double x) { return x > 0.0 && x < HUGE_VAL; }
 
-/* Linear spring-dashpot F = -k delta - gamma d(delta)/dt, effective mass m: the gamma giving the
+/** Linear spring-dashpot F = -k delta - gamma d(delta)/dt, effective mass m: the gamma giving the
  * restitution coefficient eps in [0, 1] (eps = 0: critical damping 2 sqrt(m k)). NAN outside the
  * domain (eps not in [0, 1], k or m not finite and > 0). */
 static inline double asperity_cor_linear_gamma(double eps, double k, double m) {
@@ -648,14 +656,14 @@ static inline double asperity_cor_linear_gamma(double eps, double k, double m) {
   return 2.0 * sqrt(m * k) * asperity_cor__ratio_of_eps(eps);
 }
 
-/* The inverse: eps of a linear spring-dashpot with damping gamma >= 0 (0 when critically or over-
+/** The inverse: eps of a linear spring-dashpot with damping gamma >= 0 (0 when critically or over-
  * damped: the overlap then never returns to 0). NAN outside the domain. */
 static inline double asperity_cor_linear_eps(double gamma, double k, double m) {
   if (!(gamma >= 0.0 && gamma < HUGE_VAL) || !asperity_cor__positive(k) || !asperity_cor__positive(m)) return (double)NAN;
   return asperity_cor__eps_of_ratio(gamma / (2.0 * sqrt(m * k)));
 }
 
-/* Hertz with Tsuji-type damping F = -k_n delta^(3/2) - alpha sqrt(m k_n) delta^(1/4) d(delta)/dt:
+/** Hertz with Tsuji-type damping F = -k_n delta^(3/2) - alpha sqrt(m k_n) delta^(1/4) d(delta)/dt:
  * the dimensionless alpha giving eps in [0, 1] (eps = 0: alpha = sqrt(5)); it depends on eps only.
  * NAN outside the domain. */
 static inline double asperity_cor_tsuji_alpha(double eps) {
@@ -663,7 +671,7 @@ static inline double asperity_cor_tsuji_alpha(double eps) {
   return sqrt(5.0) * asperity_cor__ratio_of_eps(eps);
 }
 
-/* The inverse: eps of a Hertz-Tsuji contact with alpha >= 0 (0 for alpha >= sqrt(5)). */
+/** The inverse: eps of a Hertz-Tsuji contact with alpha >= 0 (0 for alpha >= sqrt(5)). */
 static inline double asperity_cor_tsuji_eps(double alpha) {
   if (!(alpha >= 0.0 && alpha < HUGE_VAL)) return (double)NAN;
   return asperity_cor__eps_of_ratio(alpha / sqrt(5.0));

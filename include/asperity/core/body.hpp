@@ -22,20 +22,31 @@ class Stream;
 
 /// How asperity radii are drawn: all equal, lognormal, or discrete levels.
 struct RadiusDistribution {
-  enum class Kind { fixed, lognormal, levels };
-  Kind kind = Kind::fixed;
+  /// Which family; selects the fields that apply (the others keep their defaults and are ignored).
+  enum class Kind {
+    fixed,      ///< every asperity has `radius`
+    lognormal,  ///< ln(rho) ~ Normal(ln(median), sigma^2)
+    levels      ///< rho = levels[m] with probability fractions[m]
+  };
+  Kind kind = Kind::fixed;  ///< the family; set by the factories below
   double radius = 6.5e-7;             ///< fixed: rho [m]
   double median = 6.5e-7;             ///< lognormal: median exp(mu) [m]
   double sigma = 0.5;                 ///< lognormal: sd of ln(rho) [1]
   std::vector<double> levels;         ///< levels: radii [m]
   std::vector<double> fractions;      ///< levels: probabilities (sum 1 within 1e-9)
 
+  /// All radii equal to rho [m]. Not validated here: validate() (or the body factories) checks it.
   static RadiusDistribution fixed(double rho);
+  /// Lognormal radii with median exp(mu) = `median` [m] and sd of ln(rho) `sigma` [1] (sigma = 0
+  /// is fixed(median)). Unbounded: some laws (theory_radii.hpp) refuse it. Not validated here.
   static RadiusDistribution lognormal(double median, double sigma);
+  /// Discrete radii: levels[m] [m] with probability fractions[m] (at most kMaxRadiusLevels levels,
+  /// fractions summing to 1 within 1e-9). Not validated here: validate() checks it.
   static RadiusDistribution discrete(std::vector<double> levels, std::vector<double> fractions);
   /// "fixed(6.5e-07)", "lognormal(6.5e-07,0.5)", "levels(2e-06:0.2,5e-07:0.8)".
   std::string describe() const;
 
+  /// Field-by-field equality (also of the fields the kind ignores).
   friend bool operator==(const RadiusDistribution&, const RadiusDistribution&) = default;
 };
 
@@ -61,7 +72,9 @@ struct RoughBody {
   double base_radius = 0;          ///< sphere bodies: the central radius R [m]; 0 for meshes
   double area = 0;                 ///< surface area of the base body the centres lie on [m^2]
 
+  /// Number of asperities N.
   std::size_t size() const { return centres.size(); }
+  /// The largest asperity radius max rho_i [m]; 0 for a body without asperities.
   double max_radius() const;
 };
 

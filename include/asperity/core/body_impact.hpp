@@ -13,6 +13,7 @@
 
 namespace asperity {
 
+/// The outcome of body_impact: where the body touched, and the impact if there was one.
 struct BodyImpact {
   BodyContact contact;                 ///< world-frame contact
   std::optional<ImpactResult> result;  ///< nullopt: the contact point does not approach the plate
@@ -25,7 +26,9 @@ RigidBody world_rigid_body(const RoughBody& b, const Rotation& q);
 /// spin Omega (world frame, SI) on the plate n = +z.
 BodyImpact body_impact(const RoughBody& b, const SupportQuery& index, const Rotation& q, const Vec3& V, const Vec3& Omega,
                        const Restitution& eps_n, double eps_t = 1.0);
-/// The same under any tangential law (core/tangential.hpp).
+/// The same under any tangential law (core/tangential.hpp): eps_n is the microscopic normal
+/// coefficient of the law's normal rule (Walton's e_n), as in solve_impact(const RigidBody&, const
+/// ImpactState&, const Restitution&, const TangentialLaw&).
 BodyImpact body_impact(const RoughBody& b, const SupportQuery& index, const Rotation& q, const Vec3& V, const Vec3& Omega,
                        const Restitution& eps_n, const TangentialLaw& law);
 

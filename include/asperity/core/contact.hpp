@@ -28,6 +28,7 @@ struct Nearest {
   std::uint32_t runner_up = 0;     ///< second lowest (== index when N == 1)
   double runner_up_key = 0;        ///< its contact_key (+inf when N == 1)
 
+  /// Bit-for-bit equality: how the backends are checked against brute_lowest.
   friend bool operator==(const Nearest&, const Nearest&) = default;
 };
 
@@ -36,8 +37,17 @@ inline bool key_less(double ka, std::uint32_t ia, double kb, std::uint32_t ib) n
   return ka < kb || (ka == kb && ia < ib);
 }
 
-enum class Backend { brute, kdtree, cgal, fcl, grid };
+/// The spatial structure behind a ContactQuery. Every backend gives the same answers bit for bit;
+/// they differ in build time, memory and query speed (bench/ measures them).
+enum class Backend {
+  brute,   ///< linear scan over all centres (the reference)
+  kdtree,  ///< nanoflann kd-tree
+  cgal,    ///< CGAL's kd-tree (Spatial_searching)
+  fcl,     ///< FCL's dynamic AABB tree, a baseline (only when built with ASPERITY_WITH_FCL)
+  grid     ///< cube-map grid: centres bucketed on the six faces of a cube (gnomonic projection)
+};
 
+/// The name parse_backend reads: "brute", "kdtree", "cgal", "fcl" or "grid".
 std::string_view to_string(Backend b);
 /// Parses "brute", "kdtree" (nanoflann), "cgal" (CGAL kd-tree), "fcl", "grid".
 /// Throws std::invalid_argument naming the value otherwise.
@@ -50,6 +60,7 @@ std::span<const Backend> all_backends();
 class ContactQuery {
  public:
   virtual ~ContactQuery() = default;
+  /// Which structure this is.
   virtual Backend backend() const = 0;
   /// The two lowest asperities for the unit body-frame down direction d.
   virtual Nearest lowest(const Vec3& d) const = 0;

@@ -16,6 +16,7 @@
 
 namespace asperity {
 
+/// A 3-vector of doubles: a position [m], velocity [m/s] or unit direction [1], as each use states.
 using Vec3 = Eigen::Vector3d;
 
 /// Asperity indices are 32-bit (Nearest::index, support queries): a body carries 1 .. 2^32-1
@@ -30,6 +31,7 @@ struct SphereParams {
   double radius = 3e-3;               ///< R (varrho), central sphere radius [m]
   double asperity_radius = 6.5e-7;    ///< a (rho), asperity radius [m], 0 < a < R
 
+  /// Field-by-field equality.
   friend bool operator==(const SphereParams&, const SphereParams&) = default;
 };
 
@@ -44,7 +46,7 @@ void validate(const SphereParams& p);
 
 /// An explicit rough sphere in its body frame.
 struct RoughSphere {
-  SphereParams params;
+  SphereParams params;        ///< N, R and a it was made with
   std::vector<Vec3> centres;  ///< unit vectors u_i (asperity centre = R*u_i)
 };
 

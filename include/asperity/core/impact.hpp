@@ -23,9 +23,12 @@ struct RigidBody {
   double mass = 1;                             ///< M [kg]
   Eigen::Matrix3d inertia = Eigen::Matrix3d::Identity();  ///< J about the centre of mass, world frame [kg m^2]
 
+  /// A solid homogeneous sphere: M = mass [kg], J = (2/5) M R^2 I with R = radius [m]. Throws
+  /// std::invalid_argument unless both are finite and > 0.
   static RigidBody sphere(double mass, double radius);
 };
 
+/// The body's motion just before the impact and where it touches (world frame, SI).
 struct ImpactState {
   Vec3 V{0, 0, -1};      ///< centre-of-mass velocity before [m/s]
   Vec3 Omega{0, 0, 0};   ///< angular velocity before [rad/s]
@@ -33,6 +36,7 @@ struct ImpactState {
   Vec3 n{0, 0, 1};       ///< unit plate normal, out of the plate
 };
 
+/// The motion just after the impact, and the numbers that produced it.
 struct ImpactResult {
   Vec3 P;           ///< impulse on the body [N s]
   Vec3 V_after;     ///< [m/s]
@@ -48,6 +52,8 @@ struct ImpactResult {
 /// plate), and throws std::invalid_argument for non-finite input, |n| != 1, or V.n == 0 (eps of
 /// Eq. 1 undefined).
 std::optional<ImpactResult> solve_impact(const RigidBody& body, const ImpactState& s, double eps_n, double eps_t = 1.0);
+/// The same with a speed-dependent microscopic coefficient: eps_n is evaluated at the normal
+/// contact speed |v_n| before the impact (ImpactResult::eps_n records the value used).
 std::optional<ImpactResult> solve_impact(const RigidBody& body, const ImpactState& s, const Restitution& eps_n,
                                          double eps_t = 1.0);
 

@@ -41,8 +41,12 @@ class Stream;
 /// computes the same value, so whichever stores it first the draws are the same).
 class BinomialModeCache {
  public:
+  /// An empty cache for n = 0 .. n_max (8 bytes per entry, allocated now).
   explicit BinomialModeCache(std::uint64_t n_max) : p_(n_max + 1) {}
+  /// P(X = floor(n/2)) for X ~ Binomial(n, 1/2): from the cache for n <= max_n() (computed and
+  /// stored on first use), computed each time above. Thread-safe.
   double operator()(std::uint64_t n);
+  /// The largest n the cache keeps (n_max of the constructor).
   std::uint64_t max_n() const { return p_.size() - 1; }
 
  private:
@@ -53,11 +57,15 @@ class BinomialModeCache {
 /// `cache` (optional, any n_max) only saves work: the draw is the same with or without it.
 std::uint64_t binomial_half(std::uint64_t n, Stream& s, BinomialModeCache* cache = nullptr);
 
+/// What LazySphere::lowest answers: the two lowest asperities and the lowest one's centre (which
+/// a lazy sphere cannot hand out by index without generating the whole sphere).
 struct LazyNearest {
   Nearest nearest;  ///< as brute_lowest on materialise()
   Vec3 u{0, 0, 0};  ///< unit centre of the lowest asperity (body frame)
 };
 
+/// A rough sphere of N uniform centres generated lazily (see the file's comment): the same sample
+/// as materialise() would give, generating only the cells a query cannot rule out. One per thread.
 class LazySphere {
  public:
   /// N >= 1 (< 2^32, indices are 32-bit) centres; throws std::invalid_argument otherwise.
@@ -75,8 +83,10 @@ class LazySphere {
   /// All N centres in index order (generates the whole sphere: tests and small N only).
   std::vector<Vec3> materialise();
 
-  std::uint64_t size() const { return n_; }
+  std::uint64_t size() const { return n_; }  ///< N, the number of asperities
+  /// Cells generated (and kept) so far for this sphere, leaves and inner cells: the work done.
   std::size_t cells_generated() const { return nodes_.size(); }
+  /// Centres generated so far for this sphere (those of the leaves visited), out of N.
   std::size_t centres_generated() const { return points_.size(); }
 
  private:

@@ -13,6 +13,8 @@
 
 namespace asperity {
 
+/// A closed, consistently oriented triangle mesh: the base body of a mesh body (app/mesh_io.hpp
+/// reads it from an OFF file).
 struct TriangleMesh {
   std::vector<Vec3> vertices;                      ///< [m]
   std::vector<std::array<std::uint32_t, 3>> faces; ///< counter-clockwise seen from outside

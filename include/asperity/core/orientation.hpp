@@ -11,6 +11,7 @@
 namespace asperity {
 
 class Stream;
+/// An orientation: the unit quaternion q that maps body coordinates to world coordinates.
 using Rotation = Eigen::Quaterniond;
 
 /// A uniformly (Haar) distributed rotation, from three uniforms of the stream

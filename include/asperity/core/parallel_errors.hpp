@@ -11,6 +11,8 @@
 
 namespace asperity {
 
+/// Collects the exceptions of a parallel loop and rethrows the one of the lowest index after it,
+/// so the error is the same for any thread count and schedule. Thread-safe; one per loop.
 class LowestIndexError {
  public:
   /// Runs f(); an exception it throws is recorded against index i instead of propagating.

@@ -12,7 +12,9 @@ namespace asperity {
 class Restitution {
  public:
   virtual ~Restitution() = default;
+  /// eps_n at the normal contact speed v >= 0 [m/s]; in [0, 1].
   virtual double operator()(double v) const = 0;
+  /// A description for reports, e.g. "constant(0.9)" or "viscoelastic-pade14(beta=0.0467)".
   virtual std::string name() const = 0;
 };
 

@@ -27,21 +27,27 @@
 
 namespace asperity {
 
+/// The screening verdict of one asperity.
 enum class Screen : std::uint8_t {
   screened = 0,    ///< no direction makes it the lowest (proved by a triple of competitors)
   witness = 1,     ///< kept: a direction where it touches was found and checked by the support query
   helly = 2,       ///< kept: every triple of competitors leaves a direction (Helly)
 };
 
+/// Which asperities of a body can touch the plate, with the counts and densities derived from it.
 struct ScreeningResult {
   std::vector<Screen> status;       ///< per asperity
+  ///@{
+  /// Counts of the statuses: kept = witnessed + helly (can touch), screened (cannot), witnessed
+  /// (kept with a checked direction), helly (kept without proof); kept + screened = N.
   std::uint64_t kept = 0, screened = 0, witnessed = 0, helly = 0;
+  ///@}
   double area = 0;                  ///< 4 pi R^2 [m^2]
   double lambda = 0;                ///< N / area [1/m^2]
   double lambda_eff = 0;            ///< kept / area: areal density of asperities that can touch [1/m^2]
   double theta_cover = 0;           ///< angular radius of the largest empty cap of the centres [rad]
   double mean_competitors = 0;      ///< after the exact half-space filter
-  double seconds = 0;
+  double seconds = 0;               ///< wall-clock time of the screening [s]
 };
 
 /// Screens a rough sphere (b.base_radius > 0, centres at distance R from the origin). q must be a
@@ -102,11 +108,15 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
 /// Empirical cross-check: `directions` uniform random down directions (Stream(seed,
 /// Purpose::analysis, k)); every winner must be kept.
 struct ScreeningCheck {
-  std::uint64_t directions = 0;
+  std::uint64_t directions = 0;         ///< random down directions tried
   std::uint64_t winners_screened = 0;   ///< must be 0
   std::uint64_t distinct_winners = 0;   ///< asperities that won at least once
   std::uint64_t kept_never_hit = 0;     ///< kept but never won (small cells, or too few directions)
 };
+/// Draws `directions` uniform down directions from Stream(seed, Purpose::analysis, k), asks q for
+/// the winner of each and counts, against r (from screen_sphere or screen_body over b), winners
+/// that r screened (a bug if any) and kept asperities that never won. Serial; r.status must have
+/// one entry per asperity of b.
 ScreeningCheck check_screening(const RoughBody& b, const SupportQuery& q, const ScreeningResult& r,
                                std::uint64_t directions, std::uint64_t seed);
 

@@ -38,6 +38,7 @@ struct Support {
   std::uint32_t runner_up = 0;   ///< second (== index when N == 1)
   double runner_up_h = 0;        ///< its support value (-inf when N == 1) [m]
 
+  /// Bit-for-bit equality: how the structures are checked against brute_support.
   friend bool operator==(const Support&, const Support&) = default;
 };
 
@@ -49,9 +50,12 @@ Support brute_support(std::span<const Vec3> centres, std::span<const double> rad
 class SupportQuery {
  public:
   virtual ~SupportQuery() = default;
+  /// The two lowest asperities (largest h) for the unit body-frame down direction d, bit for bit
+  /// as brute_support.
   virtual Support support(const Vec3& d) const = 0;
   /// Indices i with |c_i - p| <= radius (any order; ascending index), exact for the computed distance.
   virtual std::vector<std::uint32_t> within(const Vec3& p, double radius) const = 0;
+  /// Bytes held by the index, beyond the caller's centres and radii.
   virtual std::size_t memory_bytes() const = 0;
 };
 

@@ -24,20 +24,34 @@
 
 namespace asperity {
 
+/// A tangential contact law and its parameters (which fields apply depends on `model`; see the
+/// file's comment and docs/tangential-laws.md). Build one with the factories; validate() checks it.
 struct TangentialLaw {
-  enum class Model { kinematic, coulomb, walton };
+  /// The law.
+  enum class Model {
+    kinematic,  ///< the paper's v'_t = eps_t v_t (Eq. 5)
+    coulomb,    ///< Coulomb friction integrated along the impulse process (Routh/Stronge)
+    walton      ///< Walton's algebraic three-parameter law (e_n, mu, beta0)
+  };
   /// Normal restitution rule of the impulse process (coulomb only).
-  enum class Normal { newton, poisson, energetic };
+  enum class Normal {
+    newton,     ///< kinematic: v'_n = -e v_n
+    poisson,    ///< kinetic: p_f = (1 + e) p_c
+    energetic   ///< Stronge: restitution work = e^2 x compression work
+  };
 
-  Model model = Model::kinematic;
+  Model model = Model::kinematic;  ///< which law
   double eps_t = 1.0;       ///< kinematic: v'_t = eps_t v_t
   double mu = 0.0;          ///< coulomb, walton: friction coefficient, in [0, kMaxMu]
   static constexpr double kMaxMu = 1e12;  ///< every impact sticks long before; see validate()
   double beta0 = -1.0;      ///< walton: tangential restitution when sticking, v'_t = -beta0 v_t, in [-1, 1]
-  Normal normal = Normal::energetic;
+  Normal normal = Normal::energetic;  ///< coulomb: how the impact ends
 
+  /// The paper's law, v'_t = eps_t v_t (1 keeps v_t, 0 sticks, -1 reverses it).
   static TangentialLaw kinematic(double eps_t = 1.0);
+  /// Coulomb friction mu [1] along the impulse process, ended by the normal rule `normal`.
   static TangentialLaw coulomb(double mu, Normal normal);
+  /// Walton's law: friction mu [1], tangential restitution beta0 in [-1, 1] when sticking.
   static TangentialLaw walton(double mu, double beta0);
   /// Coulomb friction with Stronge's energetic coefficient of restitution.
   static TangentialLaw stronge(double mu);
@@ -45,14 +59,18 @@ struct TangentialLaw {
   /// "kinematic (eps_t = 1)", "coulomb (mu = 0.1, poisson)", ...
   std::string describe() const;
 
+  /// Field-by-field equality (also of the fields the model ignores).
   friend bool operator==(const TangentialLaw&, const TangentialLaw&) = default;
 };
 
+/// "kinematic", "coulomb" or "walton" (what parse_tangential_model reads).
 std::string_view to_string(TangentialLaw::Model m);
+/// "newton", "poisson" or "energetic" (what parse_normal_rule reads).
 std::string_view to_string(TangentialLaw::Normal n);
 /// Parses "kinematic", "coulomb", "walton" / "newton", "poisson", "energetic"; throws
 /// std::invalid_argument naming the value otherwise.
 TangentialLaw::Model parse_tangential_model(std::string_view s);
+/// Parses "newton", "poisson" or "energetic"; throws std::invalid_argument naming the value otherwise.
 TangentialLaw::Normal parse_normal_rule(std::string_view s);
 
 /// Throws std::invalid_argument naming the field: eps_t finite; mu finite and >= 0; beta0 in [-1, 1].
@@ -60,7 +78,7 @@ void validate(const TangentialLaw& law);
 
 /// What the impulse process went through (coulomb; the algebraic laws fill what applies).
 struct ImpactProcess {
-  ImpactResult result;
+  ImpactResult result;          ///< the impact, as solve_impact returns it
   double p_compression = 0;     ///< normal impulse at the end of compression [N s]
   double work_normal_compression = 0;   ///< int u_n dp over compression (<= 0) [J]
   double work_normal_restitution = 0;   ///< int u_n dp over restitution (>= 0) [J]
@@ -76,6 +94,8 @@ struct ImpactProcess {
 /// for non-finite input as solve_impact does, std::runtime_error if the process does not end
 /// (a body that jams: the normal velocity stops increasing under friction).
 std::optional<ImpactResult> solve_impact(const RigidBody& body, const ImpactState& s, double eps_n, const TangentialLaw& law);
+/// The same with a speed-dependent eps_n, evaluated at the normal contact speed |v_n| before the
+/// impact.
 std::optional<ImpactResult> solve_impact(const RigidBody& body, const ImpactState& s, const Restitution& eps_n,
                                          const TangentialLaw& law);
 /// The same with the process' details.

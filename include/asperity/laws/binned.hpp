@@ -30,16 +30,24 @@ namespace asperity {
 /// Mean and second central moment of a stream (Welford); merge is Chan et al.'s formula.
 /// Deterministic: the same sequence of add/merge calls gives the same bits.
 struct Moments {
-  std::uint64_t n = 0;
+  std::uint64_t n = 0;  ///< samples counted
+  ///@{
+  /// Running mean and sum of squared deviations from it, sum (x - mean)^2 (not divided by n).
   double mean = 0, m2 = 0;
+  ///@}
+  /// Counts one sample (Welford's update; x must be finite, not checked).
   void add(double x) {
     ++n;
     const double d = x - mean;
     mean += d / double(n);
     m2 += d * (x - mean);
   }
+  /// Adds o's samples as if they had been added after this one's (Chan et al.); the result depends
+  /// on the order of merges, so callers merge in a fixed order.
   void merge(const Moments& o);
+  /// Sample variance m2 / (n - 1); 0 for n < 2.
   double variance() const { return n > 1 ? m2 / double(n - 1) : 0.0; }
+  /// Bit-for-bit equality (the determinism tests).
   friend bool operator==(const Moments&, const Moments&) = default;
 };
 
@@ -50,25 +58,34 @@ struct Moments {
 /// log10(1 + (mean - c)^2 / var) digits (the streaming run uses the reference law's mean).
 /// Deterministic like Moments.
 struct ShiftedSums {
-  std::uint64_t n = 0;
+  std::uint64_t n = 0;  ///< samples counted
+  ///@{
+  /// S1 = sum (x - c) and S2 = sum (x - c)^2 about the shift c.
   double s1 = 0, s2 = 0;
+  ///@}
+  /// Counts x about the shift c (the same c for every sample of one ShiftedSums).
   void add(double x, double c) {
     const double d = x - c;
     ++n;
     s1 += d;
     s2 += d * d;
   }
+  /// The Moments of the samples added (c: the shift they were added with).
   Moments moments(double c) const;
 };
 
 /// The reference law whose cdf makes the bins equiprobable: closed-form cdf and quantile.
 struct Reference {
+  ///@{
+  /// The family: Rayleigh (r_xy, Eq. 14) or centred normal (r_x, Eq. 18).
   enum class Kind { rayleigh, normal } kind = Kind::rayleigh;
+  ///@}
   double sigma = 1;  ///< Rayleigh scale (cdf 1 - exp(-x^2 / 2 sigma^2)) or normal standard deviation
-  double cdf(double x) const;
+  double cdf(double x) const;       ///< u = F_ref(x) in [0, 1] (0 below the Rayleigh's support)
   double quantile(double u) const;  ///< u in [0, 1]; quantile(0) and quantile(1) are the support's ends
   double mean() const;              ///< sigma sqrt(pi / 2) (Rayleigh) or 0 (normal)
   std::string name() const;         ///< e.g. "Rayleigh(sigma = 3.2e-06)"
+  /// Field-by-field equality (BinnedStats::merge requires the same reference).
   friend bool operator==(const Reference&, const Reference&) = default;
 };
 
@@ -87,6 +104,8 @@ class FineBinner {
  public:
   /// Throws std::logic_error if the computed edges are not non-decreasing.
   FineBinner(const Reference& ref, unsigned fine_log2);
+  /// The fine bin of x in [0, 2^fine_log2): the same as exact comparisons with the edges (NaN in
+  /// bin 0). Thread-safe, no allocation.
   std::size_t operator()(double x) const noexcept {
     const double g = guess(x);
     std::size_t k = g > 0 ? (g < double(last_) ? static_cast<std::size_t>(g) : last_) : 0;
@@ -99,6 +118,7 @@ class FineBinner {
   }
   /// The largest |g(x_j) - j| over the edges, plus a rounding allowance (tests, reports).
   double slack() const noexcept { return slack_; }
+  /// Bytes of the edge and interpolation tables.
   std::size_t memory_bytes() const noexcept { return (edge_.capacity() + table_.capacity()) * sizeof(double); }
 
  private:
@@ -116,17 +136,23 @@ class FineBinner {
   std::size_t last_ = 0;       // 2^k - 1
 };
 
+/// The streaming statistics of one quantity (see the file's comment): fine histogram, per-block
+/// coarse histograms and per-block moments. Make one with make_binned; merge partial ones in
+/// index order.
 struct BinnedStats {
-  Reference ref;
+  Reference ref;                       ///< the law whose cdf maps samples to u
+  ///@{
+  /// log2 of the number of fine bins (<= 24) and of coarse bins per block (4 .. 16, <= fine_log2).
   unsigned fine_log2 = 16, coarse_log2 = 10;
-  std::size_t blocks = 1;
+  ///@}
+  std::size_t blocks = 1;              ///< independent blocks (groups of whole spheres), >= 1
   std::vector<std::uint64_t> fine;     ///< 2^fine_log2 counts of u
   std::vector<std::uint64_t> coarse;   ///< blocks x 2^coarse_log2 counts of u
   std::vector<Moments> block_moments;  ///< per block
 
-  std::size_t fine_bins() const { return std::size_t{1} << fine_log2; }
-  std::size_t coarse_bins() const { return std::size_t{1} << coarse_log2; }
-  std::uint64_t n() const;
+  std::size_t fine_bins() const { return std::size_t{1} << fine_log2; }      ///< 2^fine_log2
+  std::size_t coarse_bins() const { return std::size_t{1} << coarse_log2; }  ///< 2^coarse_log2 per block
+  std::uint64_t n() const;  ///< samples counted (the sum of the fine counts)
   /// Fine bin of u: floor(u 2^k), u = 1 in the last bin.
   std::size_t fine_bin(double u) const;
   /// All blocks merged in block order.
@@ -134,6 +160,7 @@ struct BinnedStats {
   /// Adds o's counts and merges o's block moments into this one's, block by block (the caller
   /// merges in index order). Throws std::invalid_argument if the layouts differ.
   void merge(const BinnedStats& o);
+  /// Bit-for-bit equality (the thread- and rank-count independence tests).
   friend bool operator==(const BinnedStats&, const BinnedStats&) = default;
 };
 
@@ -148,11 +175,12 @@ void add_sample(BinnedStats& s, std::size_t block, double u);
 /// u of x under the reference; throws std::invalid_argument for a non-finite x.
 double reference_u(const Reference& ref, double x);
 
+/// The outcome of one binned test.
 struct BinnedTest {
   std::string statistic;     ///< "binned-KS", "chi2", "LR-block", "KS-block-bootstrap"
   double value = 0;          ///< D, chi^2 or the z of the LR
-  double p = 1;
-  std::uint64_t n = 0;
+  double p = 1;              ///< p-value (NaN when the test could not be made; the note says why)
+  std::uint64_t n = 0;       ///< samples the test used
   double resolution = 0;     ///< bin width in u of the cells the test used
   std::string note;          ///< how p was computed, in words
 };
@@ -176,10 +204,18 @@ BinnedTest binned_chi2(const BinnedStats& s, const Cdf& cdf, std::size_t cells =
 /// p from Student's t with G - 1 dof. Cells where either law has probability 0 are pooled with a
 /// neighbour. Needs blocks >= 2.
 struct LrTest {
+  ///@{
+  /// L, its standard error from the spread between blocks, and KL(p0 || p1), KL(p1 || p0) on the
+  /// cells used (nats per sample).
   double L = 0, se = 0, kl01 = 0, kl10 = 0;
-  BinnedTest law0, law1;  ///< value = z, p one-sided
-  std::size_t blocks = 0;
+  ///@}
+  ///@{
+  /// The test of law 0 (z0) and of law 1 (z1): value = z, p one-sided.
+  BinnedTest law0, law1;
+  ///@}
+  std::size_t blocks = 0;  ///< G: blocks with samples, the se's degrees of freedom + 1
 };
+/// The likelihood-ratio test above. Throws std::invalid_argument for fewer than 2 blocks.
 LrTest binned_lr(const BinnedStats& s, const Cdf& law0, const Cdf& law1);
 
 /// The coarse per-block counts as laws/block_ks.hpp bins: edges x_j = ref.quantile(j 2^-c),
@@ -189,8 +225,14 @@ BlockBins to_block_bins(const BinnedStats& s);
 
 /// Pooled cdf at the coarse edges x_j with its standard error from the spread between blocks.
 struct CdfBand {
+  ///@{
+  /// The coarse edges x_j = ref.quantile(j 2^-c), j = 1 .. 2^c - 1; the pooled fraction of samples
+  /// below each; its standard error from the spread between blocks (NaN with fewer than 2 blocks
+  /// holding samples). Equal lengths.
   std::vector<double> x, cdf, se;
+  ///@}
 };
+/// The pooled cdf of s at its coarse edges, with standard errors (for the cdf-difference figures).
 CdfBand pooled_cdf(const BinnedStats& s);
 
 /// Drops a likelihood-ratio test needs to reject law 0 at level alpha with power 1 - beta when the

@@ -29,14 +29,16 @@
 
 namespace asperity {
 
+/// Samples binned per block on a common grid: what the block bootstrap resamples (O(G J) per
+/// replicate for G blocks and J grid points, whatever the number of samples).
 struct BlockBins {
   std::vector<double> edges;               ///< grid e_j, ascending, distinct
   std::vector<std::uint32_t> counts;       ///< blocks x (edges + 1): counts of x <= e_0, (e_0, e_1], ..., > e_last
   std::vector<std::uint64_t> block_size;   ///< samples per block
-  std::size_t blocks = 0;
-  std::size_t n = 0;
+  std::size_t blocks = 0;                  ///< G, the number of blocks
+  std::size_t n = 0;                       ///< all samples
   std::vector<double> pooled;              ///< F^(e_j): fraction of all samples <= e_j
-  std::size_t cells() const { return edges.size() + 1; }
+  std::size_t cells() const { return edges.size() + 1; }  ///< counts per block: the edges + 1
 };
 
 /// Bins `x` (drops in sphere order: sphere k holds x[k m, (k+1) m), m = x.size()/spheres) on a grid
@@ -55,6 +57,7 @@ double binned_ks_distance(const BlockBins& b, const Cdf& cdf);
 void block_bootstrap_ks(const BlockBins& b, std::uint64_t seed, std::uint64_t stream, std::size_t first,
                         std::size_t count, std::vector<double>& out);
 
+/// The block-bootstrap KS test of one law.
 struct BlockKsResult {
   double D = 0;               ///< binned KS distance of the pooled sample
   double p = 1;               ///< (1 + #{D* >= D}) / (B + 1)

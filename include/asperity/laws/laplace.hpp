@@ -40,10 +40,12 @@ struct AsymmetricLaplace {
   double log_a = 0;  ///< log of the rate left of the mode
   double log_c = 0;  ///< log of the rate right of the mode
 
-  double a() const;
-  double c() const;
-  double pdf(double t) const;
+  double a() const;               ///< rate left of the mode, exp(log_a) [1/unit of t]
+  double c() const;               ///< rate right of the mode, exp(log_c) [1/unit of t]
+  double pdf(double t) const;     ///< density at t, exp(log_pdf(t))
+  /// log density at t, computed from (m, log a, log c) without forming h when one rate dominates.
   double log_pdf(double t) const;
+  /// P(T <= t): c/(a+c) e^{a (t-m)} below the mode, 1 - a/(a+c) e^{-c (t-m)} from it on.
   double cdf(double t) const;
   /// Inverse cdf, p in (0, 1).
   double quantile(double p) const;
@@ -57,13 +59,20 @@ struct AsymmetricLaplace {
 /// exponential order statistics as Renyi sums of ziggurat exponentials; laplace.cpp says more).
 void sorted_sample(const AsymmetricLaplace& law, Stream& s, std::span<double> y);
 
+/// A maximum-likelihood fit of the asymmetric Laplace law to a sample.
 struct LaplaceFit {
-  AsymmetricLaplace law;
-  std::size_t n = 0;
+  AsymmetricLaplace law;       ///< the fitted law
+  std::size_t n = 0;           ///< sample size
   std::size_t mode_rank = 0;   ///< index of m in the sorted sample
-  double log_likelihood = 0;
-  Estimate m, log_a, log_c;    ///< with Fisher standard errors
-  Estimate a, c;               ///< rates with delta-method se (se = rate x se(log rate))
+  double log_likelihood = 0;   ///< maximised log-likelihood of the whole sample, n log n - n - 2 n log(sqrt L + sqrt R)
+  ///@{
+  /// m, log a and log c with Fisher standard errors (expected information, see the file's comment).
+  Estimate m, log_a, log_c;
+  ///@}
+  ///@{
+  /// The rates a and c with delta-method se (se = rate x se(log rate)).
+  Estimate a, c;
+  ///@}
 };
 
 /// Maximum-likelihood fit. Needs n >= 3 finite values with at least one value strictly below and
@@ -72,6 +81,7 @@ LaplaceFit fit_asymmetric_laplace(std::span<const double> x);
 /// Same, for data already sorted ascending (checked).
 LaplaceFit fit_asymmetric_laplace_sorted(std::span<const double> sorted);
 
+/// The goodness of fit of a sample to its own fitted asymmetric Laplace law (laplace_gof).
 struct LaplaceGof {
   double D = 0;               ///< KS distance of the sample to its fitted law
   /// parametric-bootstrap p-value: (1 + #{D_b >= D}) / (1 + B); after a sequential stop
@@ -80,7 +90,7 @@ struct LaplaceGof {
   std::size_t bootstrap = 0;  ///< B (the budget)
   std::size_t replicates = 0;   ///< L: replicates drawn (B unless stopped_early)
   std::size_t exceedances = 0;  ///< K: replicates with D_b >= D among them
-  bool stopped_early = false;
+  bool stopped_early = false;   ///< the sequential stop ended the bootstrap before B replicates
 };
 
 /// When the bootstrap may stop before B replicates: once K >= `exceedances` replicates reached D
@@ -89,8 +99,8 @@ struct LaplaceGof {
 /// would give, and K / L estimates p (relative se ~ 1/sqrt(K), Besag & Clifford 1991). A test
 /// heading for rejection never stops early. exceedances = 0: always all B.
 struct SequentialStop {
-  std::size_t exceedances = 0;
-  double alpha = 0;
+  std::size_t exceedances = 0;  ///< K needed before stopping; 0: never stop early
+  double alpha = 0;             ///< the level of the verdict the stop must not change
 };
 
 /// KS of the sample against its own fit with a parametric-bootstrap p-value. Replicate b draws n
@@ -104,11 +114,11 @@ LaplaceGof laplace_gof(std::span<const double> sorted, const LaplaceFit& fit, st
 /// One test of laplace_gof_batch: laplace_gof's arguments but the seed (`sorted` and `fit` must
 /// outlive the call).
 struct GofJob {
-  std::span<const double> sorted;
-  const LaplaceFit* fit = nullptr;
-  std::size_t bootstrap = 0;
-  std::uint64_t stream_index = 0;
-  SequentialStop stop;
+  std::span<const double> sorted;    ///< the sample, sorted ascending
+  const LaplaceFit* fit = nullptr;   ///< its fit (fit_asymmetric_laplace_sorted of `sorted`)
+  std::size_t bootstrap = 0;         ///< B, the replicate budget
+  std::uint64_t stream_index = 0;    ///< keeps the replicates of different tests apart
+  SequentialStop stop;               ///< when the bootstrap may stop early
 };
 
 /// Several laplace_gof at once: the replicates of all jobs in one parallel loop (largest n B

@@ -16,14 +16,16 @@
 
 namespace asperity {
 
+/// A cumulative distribution function F(x) = P(X <= x), values in [0, 1], non-decreasing.
 using Cdf = std::function<double(double)>;
 
 /// A value with its standard error (se is NaN when it cannot be estimated, e.g. one batch).
 struct Estimate {
-  double value = 0;
-  double se = 0;
+  double value = 0;  ///< the estimate
+  double se = 0;     ///< its standard error, same unit (NaN: not estimable)
 };
 
+/// The outcome of a Kolmogorov-Smirnov test.
 struct KsResult {
   double D = 0;        ///< sup |F_n - F|
   double p = 1;        ///< p-value under H0 (iid samples from F; F continuous)
@@ -95,14 +97,22 @@ KsResult ks_two_sample(std::span<const double> a_sorted, std::span<const double>
 
 /// Fixed-width histogram on [lo, hi). Samples outside are counted in `under`/`over`.
 struct Histogram {
+  ///@{
+  /// The binned range [lo, hi), in the samples' unit.
   double lo = 0, hi = 1;
-  std::vector<double> counts;
+  ///@}
+  std::vector<double> counts;  ///< samples per bin (whole numbers, stored as doubles)
   std::size_t total = 0;  ///< all samples, including under/over
+  ///@{
+  /// Samples below lo and at or above hi.
   std::size_t under = 0, over = 0;
+  ///@}
 
-  std::size_t bins() const { return counts.size(); }
-  double width() const { return (hi - lo) / static_cast<double>(counts.size()); }
+  std::size_t bins() const { return counts.size(); }  ///< number of bins
+  double width() const { return (hi - lo) / static_cast<double>(counts.size()); }  ///< bin width (hi - lo)/bins
+  /// Centre of bin i (no range check).
   double centre(std::size_t i) const { return lo + (static_cast<double>(i) + 0.5) * width(); }
+  /// Left edge of bin i (no range check).
   double left(std::size_t i) const { return lo + static_cast<double>(i) * width(); }
   /// Density estimate count/(total*width), normalised over ALL samples so that it compares
   /// directly with a pdf (sum_i density(i) * width() = 1 - (under + over)/total).
@@ -116,10 +126,11 @@ struct Histogram {
 /// gives a valid histogram with total = 0 (whose density() throws).
 Histogram make_histogram(std::span<const double> x, double lo, double hi, std::size_t bins);
 
+/// The outcome of chi2_test.
 struct Chi2Result {
-  double chi2 = 0;
-  int dof = 0;
-  double p = 1;
+  double chi2 = 0;  ///< Pearson's statistic sum (O - E)^2 / E over the merged cells
+  int dof = 0;      ///< degrees of freedom, cells - 1
+  double p = 1;     ///< P(chi2_dof >= chi2); NaN when fewer than 2 cells remain
 };
 /// Pearson chi-square of a histogram against a cdf; adjacent bins are merged until each
 /// expected count is >= min_expected (5 by the usual rule), and under/over flow bins are
@@ -142,9 +153,13 @@ double quantile_sorted(std::span<const double> sorted, double prob);
 /// O(n) per distinct rank. Reorders `x`. Same throws as quantile_sorted (for empty x, NaN x, prob).
 std::vector<double> quantiles_unsorted(std::vector<double>& x, std::span<const double> probs);
 
+/// Mean, standard deviation and quantiles of a sample, each with its standard error.
 struct Summary {
-  std::size_t n = 0;
+  std::size_t n = 0;                  ///< sample size
+  ///@{
+  /// Mean and standard deviation (n - 1 denominator), with standard errors.
   Estimate mean, std;
+  ///@}
   std::vector<double> probs;          ///< quantile levels
   std::vector<Estimate> quantiles;    ///< same length as probs
   std::size_t batches = 0;            ///< number of batches used for the se (n for iid)

@@ -19,7 +19,8 @@ namespace asperity {
 struct Law {
   std::string name;         ///< report name, e.g. "eq14", "exact-sphere", "eq18"
   std::string description;  ///< one line for humans
-  Cdf cdf;
+  Cdf cdf;                  ///< F(x) = P(X <= x), right-continuous (atoms included)
+  /// Density (of the continuous part, for a law with an atom): what the figures overlay.
   std::function<double(double)> pdf;
   double mean = 0;          ///< expectation of the law [same unit as its variable]
 };

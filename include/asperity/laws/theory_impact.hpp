@@ -36,6 +36,9 @@
 
 namespace asperity {
 
+/// The scene of the Sec. IV laws: one rough sphere hitting the plate at normal incidence with
+/// spin, with the paper's viscoelastic eps_n(v) (Pade [1/4], restitution.hpp). Frame as in the
+/// file's comment; validate() checks it.
 struct ImpactScene {
   std::uint64_t asperities = 100000;  ///< N
   double radius = 3e-3;               ///< R [m]
@@ -58,6 +61,8 @@ void validate(const ImpactScene& s);
 /// Distribution of eps. Names: "eq28-printed", "eq28-corrected".
 /// `alpha_scale` multiplies alpha (1 = the law; tests use 1.05 as a deliberately wrong law).
 Law eq28_printed(const ImpactScene& s);
+/// The corrected law of eps (see the file's comment), with the core-contact atom if
+/// s.core_contacts; alpha_scale as above. Name "eq28-corrected".
 Law eq28_corrected(const ImpactScene& s, double alpha_scale = 1.0);
 
 /// The paper's own route (Eqs. 26-27: r_x + r_y ~ r_xy Rayleigh, r_z = R + a constant) carried
@@ -70,6 +75,7 @@ Law eq28_paper_route(const ImpactScene& s);
 /// Distribution of Omega'_x. Names: "eq33-printed", "eq33-corrected" (Gaussians; the corrected
 /// one with an atom at Omega_x if core_contacts). `sigma_scale` multiplies sigma_c.
 Law eq33_printed(const ImpactScene& s);
+/// Normal(Omega_x, sigma_c^2), with an atom at Omega_x if s.core_contacts. Name "eq33-corrected".
 Law eq33_corrected(const ImpactScene& s, double sigma_scale = 1.0);
 
 /// Numbers behind the laws (SI), for reports, tests and docs/sec4-derivations.md.
@@ -90,6 +96,7 @@ struct ImpactLawParameters {
   double r_star = 0;     ///< sqrt(2 a R - a^2): r_xy beyond which the core touches [m]
   double p_core = 0;     ///< exp(-r*^2/(2 sigma^2)): probability of a core contact (flat cap)
 };
+/// The numbers of the scene s at its speed s.speed (validates s).
 ImpactLawParameters impact_law_parameters(const ImpactScene& s);
 /// The same with eps_n from `eps_n`, which must be viscoelastic_pade14(s.beta) (the same values bit
 /// for bit): for callers that evaluate many speeds of one scene (the paper's bounce procedure,
@@ -119,16 +126,20 @@ double eq28_paper_route_eps(const ImpactLawParameters& p, double u, double omega
 /// impact, the same marginal with beta1 -> (1 + eps_n)/u: Omega_x s, s ~ Rayleigh, Omega_x ~
 /// Normal(0, S_k^2) given s is Normal(0, S_k^2 s^2), as |Omega| r_perp is. `paper_route` selects that.
 struct BounceResidualLaw {
-  unsigned k = 1;
+  unsigned k = 1;      ///< impact number, 1 for the first
   double speed = 0;    ///< u_k [m/s]
   double eps_n = 0;    ///< eps_n(u_k)
   double spin_sd = 0;  ///< S_k [rad/s]
   double tau = 0;      ///< [m]
-  double a1 = 0, a2 = 0;  ///< scales below / above the mode [1]
-  double rate_below() const { return 1.0 / a1; }
+  ///@{
+  /// Scales below / above the mode [1]: residual = a2 E2 - a1 E1 (a2 = 0 at k = 1).
+  double a1 = 0, a2 = 0;
+  ///@}
+  double rate_below() const { return 1.0 / a1; }  ///< 1/a1: the Laplace rate left of the mode [1]
+  /// 1/a2: the rate right of the mode; +inf at k = 1 (one-sided law) [1].
   double rate_above() const { return a2 > 0 ? 1.0 / a2 : 1.0 / 0.0; }
   double cdf(double t) const;  ///< of the residual
-  double mean() const { return a2 - a1; }
+  double mean() const { return a2 - a1; }  ///< of the residual: a2 - a1 = -2 alpha sigma^2
 };
 /// Laws for k = 1 ... k_max (index k - 1); fewer when the linearised speed of impact k is not > 0.
 std::vector<BounceResidualLaw> bounce_residual_laws(const ImpactScene& s, unsigned k_max, bool paper_route = false);

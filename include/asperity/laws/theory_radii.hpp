@@ -18,6 +18,7 @@
 
 namespace asperity {
 
+/// The contact of one fresh random rough sphere with level radii (fresh_levels_contact).
 struct FreshContact {
   Vec3 r{0, 0, 0};       ///< contact point - centre, world frame (down = -z) [m]
   double rho = 0;        ///< radius of the touching asperity [m]

@@ -7,6 +7,7 @@
 
 namespace asperity {
 
+/// What a test concluded about a law.
 enum class Verdict {
   accept,        ///< p >= alpha
   reject,        ///< p < alpha
@@ -28,7 +29,7 @@ struct LawTest {
   std::string quantity;               ///< e.g. "r_xy", "r_x", "eps", "omega_x_after", "core_contacts"
   std::string law;                    ///< e.g. "eq14", "exact-sphere", "exact-levels", "gauss-lambda"
   bool decisive = false;              ///< counts towards the exit status
-  Verdict verdict = Verdict::skipped;
+  Verdict verdict = Verdict::skipped;  ///< the outcome (skipped until the test is made)
   std::string note;                   ///< how the p-value was made, or why the law was not tested
 };
 
