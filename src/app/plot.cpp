@@ -123,7 +123,8 @@ Figure histogram_figure(const HistogramFigure& fig) {
       if (l.x[i] >= f.x_lo && l.x[i] <= f.x_hi) curve_max = std::max(curve_max, l.y[i]);
   const double top = std::max(ymax, std::min(curve_max, 2.0 * ymax));
   // The legend sits in the top panel above everything plotted: headroom for its rows.
-  const double key_frac = std::min(0.5, (21.0 * (1.0 + static_cast<double>(fig.curves.size())) + 24.0) / 400.0);
+  // (~24 px per row in a plot area ~380 px high).
+  const double key_frac = std::min(0.55, (24.0 * (1.0 + static_cast<double>(fig.curves.size())) + 30.0) / 380.0);
   lin.y_lo = 0, lin.y_hi = top / (1.0 - key_frac);
   // Log panel: from the decade at or below a third of the smallest non-zero density (a single
   // count sits clearly above the axis), at least two labelled decades. Empty bins are omitted.

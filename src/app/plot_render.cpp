@@ -247,9 +247,23 @@ void draw_legend(const Panel& p, Palette& pal) {
                                             : PL_POSITION_TOP | PL_POSITION_RIGHT;
   const auto n = static_cast<PLINT>(texts.size());
   PLFLT w = 0, h = 0;
-  pllegend(&w, &h, 0, pos, 0.02, 0.03, 0.08, 0, 1, 1, n, 1, n, opt.data(), 0.8, 0.8, 2.0, 0.0, text_colour.data(),
+  pllegend(&w, &h, 0, pos, 0.02, 0.03, 0.08, 0, 1, 1, n, 1, n, opt.data(), 0.8, 0.8, 1.7, 0.0, text_colour.data(),
            text.data(), colour.data(), box_pattern.data(), box_scale.data(), box_width.data(), colour.data(), style.data(),
            width.data(), colour.data(), sym_scale.data(), sym_n.data(), symbols.data());
+}
+
+// Tick labels of linear axes as plain numbers (%g): PLplot's own labels move a common power of ten
+// into a "(x10^-3)" beside the axis, which collides with the title. `data` holds the axes' spans,
+// to print rounding noise at zero (1e-17) as 0.
+struct Spans {
+  double x = 1, y = 1;
+};
+
+void number_label(PLINT axis, PLFLT value, char* label, PLINT length, PLPointer data) {
+  const auto* s = static_cast<const Spans*>(data);
+  const double span = axis == PL_X_AXIS ? s->x : s->y;
+  if (std::abs(value) < 1e-9 * span) value = 0;
+  std::snprintf(label, static_cast<std::size_t>(length), "%g", value);
 }
 
 // One panel in the viewport [vx0, vx1] x [vy0, vy1] (fractions of the page).
@@ -269,7 +283,10 @@ void draw_panel(const Figure& fig, const Panel& p, double vx0, double vx1, doubl
   draw_lines(p, ax, pal);
   draw_points(p, ax, pal);
   plcol0(1);
-  plbox("bcnst", 0, 0, ax.log ? "bcnstlv" : "bcnstv", 0, 0);
+  Spans spans{xb - xa, yb - ya};
+  plslabelfunc(number_label, &spans);
+  plbox("bcnsto", 0, 0, ax.log ? "bcnstlv" : "bcnstvo", 0, 0);
+  plslabelfunc(nullptr, nullptr);
   plmtex("b", 3.0, 0.5, 0.5, plplot_text(fig.xlabel).c_str());
   plmtex("l", ax.log ? 4.6 : 5.2, 0.5, 0.5, plplot_text(p.ylabel).c_str());
   draw_legend(p, pal);
