@@ -263,7 +263,16 @@ void number_label(PLINT axis, PLFLT value, char* label, PLINT length, PLPointer 
   const auto* s = static_cast<const Spans*>(data);
   const double span = axis == PL_X_AXIS ? s->x : s->y;
   if (std::abs(value) < 1e-9 * span) value = 0;
-  std::snprintf(label, static_cast<std::size_t>(length), "%g", value);
+  char text[64];
+  std::snprintf(text, sizeof text, "%g", value);
+  // "2e+06" as "2×10^6" (PLplot's superscript escapes, in our own text only).
+  std::string out = text;
+  if (const auto e = out.find('e'); e != std::string::npos) {
+    const std::string mantissa = out.substr(0, e);
+    const int exponent = std::atoi(out.c_str() + e + 1);
+    out = (mantissa == "1" ? "" : mantissa == "-1" ? "-" : mantissa + "\xC3\x97") + "10#u" + std::to_string(exponent) + "#d";
+  }
+  std::snprintf(label, static_cast<std::size_t>(length), "%s", out.c_str());
 }
 
 // One panel in the viewport [vx0, vx1] x [vy0, vy1] (fractions of the page).
