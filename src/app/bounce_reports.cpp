@@ -253,7 +253,8 @@ Figure bounce_figure(const BounceVariantReport& r, const std::vector<const Bounc
 }
 }  // namespace
 
-std::vector<std::string> write_bounce_plots(const std::filesystem::path& dir, const std::vector<BounceVariantReport>& reports) {
+std::vector<std::string> write_bounce_plots(const std::filesystem::path& dir, const std::vector<BounceVariantReport>& reports,
+                                            const PlotFormats& formats) {
   std::vector<std::string> files;
   for (const auto& r : reports) {
     std::vector<const BounceGroup*> gs;
@@ -261,7 +262,7 @@ std::vector<std::string> write_bounce_plots(const std::filesystem::path& dir, co
       if (g.by == "speed" && g.fitted) gs.push_back(&g);
     if (gs.empty()) continue;
     // A failure throws; the run's own clean-up removes the figures written before it.
-    const auto written = write_figure(dir, "fig6_" + std::string(to_string(r.variant)), bounce_figure(r, gs));
+    const auto written = write_figure(dir, "fig6_" + std::string(to_string(r.variant)), bounce_figure(r, gs), formats);
     files.insert(files.end(), written.begin(), written.end());
   }
   return files;
@@ -415,13 +416,14 @@ std::string to_json(const MeshBounceReport& r) {
   return j.dump(2) + "\n";
 }
 
-std::vector<std::string> write_mesh_bounce_plots(const std::filesystem::path& dir, const MeshBounceReport& r) {
+std::vector<std::string> write_mesh_bounce_plots(const std::filesystem::path& dir, const MeshBounceReport& r,
+                                                 const PlotFormats& formats) {
   std::vector<std::string> plots =
       write_figure(dir, "eps_vs_speed",
-                   eps_vs_speed_figure(r.report, r.experiment.options.bounce, "ε against impact speed: " + mesh_bounce_subtitle(r)));
+                   eps_vs_speed_figure(r.report, r.experiment.options.bounce, "ε against impact speed: " + mesh_bounce_subtitle(r)), formats);
   try {
-    for (const auto& f : write_figures(dir, r.figures)) plots.push_back(f);
-    for (const auto& f : write_bounce_plots(dir, {r.report.base})) plots.push_back(f);
+    for (const auto& f : write_figures(dir, r.figures, formats)) plots.push_back(f);
+    for (const auto& f : write_bounce_plots(dir, {r.report.base}, formats)) plots.push_back(f);
   } catch (...) {
     for (const auto& f : plots) {
       std::error_code ec;

@@ -95,6 +95,7 @@ std::string checkpoint_key(const Scene& s) {
   Scene k = s;
   k.ensemble.threads = 0;
   k.plots = true;
+  k.plot_format = "png";  // figures change no result
   k.out = "DIR";  // the directory may be named differently (relative, absolute) when resumed
   return to_toml(k);
 }

@@ -804,7 +804,7 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
     }
     figures.push_back({set.quantity + ".png", std::move(fig)});
   }
-  return write_figures(dir, figures);
+  return write_figures(dir, figures, parse_plot_formats(scene.plot_format));
 }
 
 }  // namespace asperity

@@ -338,7 +338,8 @@ GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progr
     // without PLplot gets the report without the figure.
     if (plotting_available()) {
       t0 = std::chrono::steady_clock::now();
-      r.plots = write_figure(dir.empty() ? run.out : dir, "finite_n", band_figure(finite_n_figure(run, cs)));
+      r.plots = write_figure(dir.empty() ? run.out : dir, "finite_n", band_figure(finite_n_figure(run, cs)),
+                           parse_plot_formats(run.plot_format));
       r.timings_s.emplace_back("plots", since(t0));
       plan.stage("plots").seconds = r.timings_s.back().second;
     }

@@ -69,7 +69,7 @@ std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& 
     scene.share = share.ranks > 1 && streams(scene) ? share : StreamShare{};
     quiet = o.quiet || share.rank > 0;
     if (scene.plots && share.rank == 0)  // only rank 0 draws
-      if (const std::string why = plotting_problem(); !why.empty())
+      if (const std::string why = plotting_problem(parse_plot_formats(scene.plot_format)); !why.empty())
         throw BadInput("figures cannot be drawn: " + why + "; or pass --no-plots");
     check_scene_inputs(scene);
     check_memory(scene);
