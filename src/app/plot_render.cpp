@@ -46,6 +46,7 @@ void validate(const Figure& fig) {
     throw std::invalid_argument("figure: size outside 100..10000 pixels");
   if (fig.data_panel >= fig.panels.size()) throw std::invalid_argument("figure: data_panel names no panel");
   if (!std::isfinite(fig.x_lo) || !std::isfinite(fig.x_hi)) throw std::invalid_argument("figure: x range not finite");
+  if (fig.log_x && fig.x_hi > fig.x_lo && !(fig.x_lo > 0)) throw std::invalid_argument("figure: log x with x_lo <= 0");
   for (const Panel& p : fig.panels) {
     if (!std::isfinite(p.y_lo) || !std::isfinite(p.y_hi)) throw std::invalid_argument("figure: y range not finite");
     if (p.log_y && p.y_hi > p.y_lo && !(p.y_lo > 0)) throw std::invalid_argument("figure: log panel with y_lo <= 0");
@@ -72,12 +73,17 @@ std::pair<double, double> x_range(const Figure& fig) {
   if (fig.x_hi > fig.x_lo) return {fig.x_lo, fig.x_hi};
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
   auto take = [&](const std::vector<double>& x) {
-    for (double v : x) lo = std::min(lo, v), hi = std::max(hi, v);
+    for (double v : x)
+      if (!fig.log_x || v > 0) lo = std::min(lo, v), hi = std::max(hi, v);
   };
   for (const Panel& p : fig.panels) {
     for (const auto& s : p.points) take(s.x);
     for (const auto& s : p.lines) take(s.x);
     for (const auto& s : p.bands) take(s.x);
+  }
+  if (fig.log_x) {
+    if (!(hi >= lo)) return {1.0, 10.0};
+    return {std::pow(10.0, std::floor(std::log10(lo))), std::pow(10.0, std::ceil(std::log10(hi) + 1e-12))};
   }
   if (!(hi > lo)) return {std::isfinite(lo) ? lo - 1 : 0.0, std::isfinite(hi) ? hi + 1 : 1.0};
   return {lo, hi};
@@ -159,19 +165,25 @@ struct Palette {
   }
 };
 
-// Plot coordinates: log panels are drawn in log10(y).
+// Plot coordinates: logarithmic axes are drawn in log10 of the value.
 struct Axes {
-  bool log = false;
+  bool log = false, log_x = false;
   double floor = 0;  ///< log: values <= 0 (error bars reaching below) are drawn at this log10 value
   double y(double v) const { return log ? (v > 0 ? std::max(std::log10(v), floor) : floor) : v; }
+  double x(double v) const { return log_x ? std::log10(v) : v; }
+  /// Whether (x, y) can be drawn at all (a logarithmic axis has no place for values <= 0).
+  bool shown(double xv, double yv) const { return (!log_x || xv > 0) && (!log || yv > 0); }
 };
 
 void draw_bands(const Panel& p, const Axes& ax, Palette& pal) {
   for (const auto& b : p.bands) {
     if (b.x.size() < 2) continue;
     std::vector<PLFLT> x, y;
-    for (std::size_t i = 0; i < b.x.size(); ++i) x.push_back(b.x[i]), y.push_back(ax.y(b.lo[i]));
-    for (std::size_t i = b.x.size(); i-- > 0;) x.push_back(b.x[i]), y.push_back(ax.y(b.hi[i]));
+    for (std::size_t i = 0; i < b.x.size(); ++i)
+      if (ax.shown(b.x[i], 1)) x.push_back(ax.x(b.x[i])), y.push_back(ax.y(b.lo[i]));
+    for (std::size_t i = b.x.size(); i-- > 0;)
+      if (ax.shown(b.x[i], 1)) x.push_back(ax.x(b.x[i])), y.push_back(ax.y(b.hi[i]));
+    if (x.size() < 3) continue;
     plcol0(pal.index(b.colour));
     plfill(static_cast<PLINT>(x.size()), x.data(), y.data());
   }
@@ -189,11 +201,11 @@ void draw_lines(const Panel& p, const Axes& ax, Palette& pal) {
       x.clear(), y.clear();
     };
     for (std::size_t i = 0; i < l.x.size(); ++i) {
-      if (ax.log && !(l.y[i] > 0)) {
+      if (!ax.shown(l.x[i], l.y[i])) {
         flush();
         continue;
       }
-      x.push_back(l.x[i]), y.push_back(ax.y(l.y[i]));
+      x.push_back(ax.x(l.x[i])), y.push_back(ax.y(l.y[i]));
     }
     flush();
   }
@@ -205,8 +217,8 @@ void draw_points(const Panel& p, const Axes& ax, Palette& pal) {
   for (const auto& s : p.points) {
     std::vector<PLFLT> x, y, lo, hi;
     for (std::size_t i = 0; i < s.x.size(); ++i) {
-      if (ax.log && !(s.y[i] > 0)) continue;
-      x.push_back(s.x[i]), y.push_back(ax.y(s.y[i]));
+      if (!ax.shown(s.x[i], s.y[i])) continue;
+      x.push_back(ax.x(s.x[i])), y.push_back(ax.y(s.y[i]));
       lo.push_back(ax.y(s.y[i] - s.se[i])), hi.push_back(ax.y(s.y[i] + s.se[i]));
     }
     if (x.empty()) continue;
@@ -280,13 +292,13 @@ void draw_panel(const Figure& fig, const Panel& p, double vx0, double vx1, doubl
   const auto [xa, xb] = x_range(fig);
   const auto [ya, yb] = y_range(p);
   Axes ax;
-  ax.log = p.log_y;
+  ax.log = p.log_y, ax.log_x = fig.log_x;
   if (ax.log) ax.floor = std::log10(ya) - 1;
   plvpor(vx0, vx1, vy0, vy1);
-  plwind(xa, xb, ax.y(ya), ax.y(yb));
+  plwind(ax.x(xa), ax.x(xb), ax.y(ya), ax.y(yb));
   if (p.grid) {
     plcol0(2);
-    plbox("g", 0, 0, ax.log ? "gh" : "g", 0, 0);
+    plbox(ax.log_x ? "gh" : "g", 0, 0, ax.log ? "gh" : "g", 0, 0);
   }
   draw_bands(p, ax, pal);
   draw_lines(p, ax, pal);
@@ -294,7 +306,7 @@ void draw_panel(const Figure& fig, const Panel& p, double vx0, double vx1, doubl
   plcol0(1);
   Spans spans{xb - xa, yb - ya};
   plslabelfunc(number_label, &spans);
-  plbox("bcnsto", 0, 0, ax.log ? "bcnstlv" : "bcnstvo", 0, 0);
+  plbox(ax.log_x ? "bcnstl" : "bcnsto", 0, 0, ax.log ? "bcnstlv" : "bcnstvo", 0, 0);
   plslabelfunc(nullptr, nullptr);
   plmtex("b", 3.0, 0.5, 0.5, plplot_text(fig.xlabel).c_str());
   plmtex("l", ax.log ? 4.6 : 5.2, 0.5, 0.5, plplot_text(p.ylabel).c_str());

@@ -63,7 +63,8 @@ struct Panel {
 struct Figure {
   std::string title;
   std::string xlabel;  ///< with units, e.g. "r_{xy} [µm]"; under every panel
-  double x_lo = 0, x_hi = 0;  ///< x_hi <= x_lo: from the data
+  double x_lo = 0, x_hi = 0;  ///< x_hi <= x_lo: from the data (log: decades)
+  bool log_x = false;         ///< logarithmic x (values <= 0 are not drawn)
   int width = 900, height = 1000;  ///< pixels of the PNG (SVG/PDF: the same aspect)
   std::vector<Panel> panels;
   /// The panel whose series the CSV holds (the others show the same data differently).
