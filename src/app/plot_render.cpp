@@ -25,15 +25,6 @@ namespace asperity::detail {
 
 namespace {
 
-const char* device_of(ImageFormat f) {
-  switch (f) {
-    case ImageFormat::png: return "pngcairo";
-    case ImageFormat::svg: return "svgcairo";
-    case ImageFormat::pdf: return "pdfcairo";
-  }
-  return "pngcairo";
-}
-
 void check_values(const std::vector<double>& v, std::size_t n, const std::string& what) {
   if (v.size() != n) throw std::invalid_argument("figure: " + what + " has a length different from x");
   for (double x : v)
@@ -66,6 +57,21 @@ void validate(const Figure& fig) {
       check_values(s.hi, s.x.size(), "band \"" + s.label + "\" hi");
     }
   }
+}
+
+}  // namespace
+
+#ifdef ASPERITY_HAVE_PLPLOT
+
+namespace {
+
+const char* device_of(ImageFormat f) {
+  switch (f) {
+    case ImageFormat::png: return "pngcairo";
+    case ImageFormat::svg: return "svgcairo";
+    case ImageFormat::pdf: return "pdfcairo";
+  }
+  return "pngcairo";
 }
 
 // The x range: the figure's, else from every series.
@@ -108,12 +114,6 @@ std::pair<double, double> y_range(const Panel& p) {
   const double pad = hi > lo ? 0.05 * (hi - lo) : 0.5 * std::max(1.0, std::abs(hi));
   return {lo - pad, hi + pad};
 }
-
-}  // namespace
-
-#ifdef ASPERITY_HAVE_PLPLOT
-
-namespace {
 
 std::mutex& plplot_mutex() {
   static std::mutex m;

@@ -336,10 +336,9 @@ GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progr
                                  "of r_xy with its band between blocks, against the exact finite-N law)";
     // validate-geometry refuses a run that asks for figures it cannot draw; a library caller
     // without PLplot gets the report without the figure.
-    if (plotting_available()) {
+    if (const PlotFormats formats = parse_plot_formats(run.plot_format); plotting_problem(formats).empty()) {
       t0 = std::chrono::steady_clock::now();
-      r.plots = write_figure(dir.empty() ? run.out : dir, "finite_n", band_figure(finite_n_figure(run, cs)),
-                           parse_plot_formats(run.plot_format));
+      r.plots = write_figure(dir.empty() ? run.out : dir, "finite_n", band_figure(finite_n_figure(run, cs)), formats);
       r.timings_s.emplace_back("plots", since(t0));
       plan.stage("plots").seconds = r.timings_s.back().second;
     }
