@@ -224,6 +224,8 @@ asperity::Figure rve_figure(const std::vector<Row>& rows, const std::vector<Stra
     LineSeries l;
     l.label = strategies[k].name;
     l.colour = kOkabeIto[k % std::size(kOkabeIto)];
+    constexpr Dash dashes[] = {Dash::solid, Dash::dashed, Dash::dash_dot};
+    l.dash = dashes[(k / std::size(kOkabeIto)) % std::size(dashes)];  // 13 strategies, 6 colours
     PointSeries pts;
     pts.label = strategies[k].name + " (runs)";
     pts.in_legend = false, pts.colour = l.colour;

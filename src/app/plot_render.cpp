@@ -224,7 +224,11 @@ void draw_points(const Panel& p, const Axes& ax, Palette& pal) {
     if (x.empty()) continue;
     plcol0(pal.index(s.colour));
     plwidth(1.2);
-    plerry(static_cast<PLINT>(x.size()), x.data(), lo.data(), hi.data());
+    // Error bars where there is an error (a bar of zero length would still draw its end ticks).
+    std::vector<PLFLT> bx, blo, bhi;
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (hi[i] > lo[i]) bx.push_back(x[i]), blo.push_back(lo[i]), bhi.push_back(hi[i]);
+    if (!bx.empty()) plerry(static_cast<PLINT>(bx.size()), bx.data(), blo.data(), bhi.data());
     plschr(0, 0.5 * s.size);
     plstring(static_cast<PLINT>(x.size()), x.data(), y.data(), kMarker);
     plschr(0, kTextScale);
