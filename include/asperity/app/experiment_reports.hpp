@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // What app/ makes of the experiments' reports: tables, report.json bodies (to_json: the JSON body;
-// the common header is report.hpp's with_header) and the gnuplot figures drawn from report data.
+// the common header is report.hpp's with_header) and the figures drawn from report data (plot.hpp).
 #include <filesystem>
 #include <string>
 #include <vector>
