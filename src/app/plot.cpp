@@ -160,6 +160,16 @@ Figure band_figure(const BandFigure& fig) {
   constexpr Rgb colours[] = {{0xc0, 0x39, 0x2b}, {0x55, 0x55, 0x55}};
   p.lines = law_lines(fig.curves, fig.x_scale, fig.y_scale);
   for (std::size_t k = 0; k < p.lines.size(); ++k) p.lines[k].colour = colours[k % 2], p.lines[k].dash = Dash::solid;
+  // y from the data, with headroom above it for the legend's rows (~24 px each of ~580).
+  double lo = 0, hi = 0;
+  for (std::size_t i = 0; i < p.points[0].y.size(); ++i)
+    lo = std::min(lo, p.points[0].y[i] - p.points[0].se[i]), hi = std::max(hi, p.points[0].y[i] + p.points[0].se[i]);
+  for (const auto& l : p.lines)
+    for (double v : l.y) lo = std::min(lo, v), hi = std::max(hi, v);
+  if (hi > lo) {
+    const double key_frac = std::min(0.5, (24.0 * (1.0 + static_cast<double>(p.lines.size())) + 30.0) / 580.0);
+    p.y_lo = lo - 0.05 * (hi - lo), p.y_hi = hi + (hi - lo) * key_frac / (1.0 - key_frac);
+  }
   f.panels = {std::move(p)};
   return f;
 }

@@ -139,6 +139,13 @@ bool has_device(const char* name) {
 // character is ~14 pixels wide on average with the cairo drivers.
 constexpr double kTextScale = 0.8, kCharPixels = 14.0;
 
+// Characters drawn (sub/superscript markup and escapes not counted).
+std::size_t glyphs(const std::string& markup) {
+  std::size_t n = 0;
+  for (unsigned char c : plain_text(markup)) n += (c & 0xC0) != 0x80;
+  return n;
+}
+
 constexpr const char* kMarker = "\xE2\x97\x8F";  // U+25CF BLACK CIRCLE, drawn centred on each point
 
 // PLplot's line styles (pllsty): the pattern is drawn and shown in the legend alike.
@@ -236,7 +243,8 @@ void draw_points(const Panel& p, const Axes& ax, Palette& pal) {
   plwidth(1);
 }
 
-void draw_legend(const Panel& p, Palette& pal) {
+// The legend inside the panel (`width_px` wide): its text shrinks until its longest entry fits.
+void draw_legend(const Panel& p, double width_px, Palette& pal) {
   if (p.legend == LegendAt::none) return;
   std::vector<std::string> texts;
   std::vector<PLINT> opt, colour, style, box_pattern, sym_n;
@@ -262,8 +270,17 @@ void draw_legend(const Panel& p, Palette& pal) {
          : p.legend == LegendAt::top_left   ? PL_POSITION_TOP | PL_POSITION_LEFT
                                             : PL_POSITION_TOP | PL_POSITION_RIGHT;
   const auto n = static_cast<PLINT>(texts.size());
+  std::size_t longest = 1;
+  auto longest_of = [&](const auto& series) {
+    for (const auto& x : series)
+      if (x.in_legend) longest = std::max(longest, glyphs(x.label));
+  };
+  longest_of(p.points), longest_of(p.lines), longest_of(p.bands);
+  constexpr double scale = 0.8;  // of the current text size
+  const double room = 0.9 * width_px - 0.08 * width_px - 40;  // minus the symbols' column and the margins
+  const double text_scale = std::max(0.45, scale * std::min(1.0, room / (static_cast<double>(longest) * kCharPixels * kTextScale * scale)));
   PLFLT w = 0, h = 0;
-  pllegend(&w, &h, 0, pos, 0.02, 0.03, 0.08, 0, 1, 1, n, 1, n, opt.data(), 0.8, 0.8, 1.7, 0.0, text_colour.data(),
+  pllegend(&w, &h, 0, pos, 0.02, 0.03, 0.08, 0, 1, 1, n, 1, n, opt.data(), 0.8, text_scale, 1.7, 0.0, text_colour.data(),
            text.data(), colour.data(), box_pattern.data(), box_scale.data(), box_width.data(), colour.data(), style.data(),
            width.data(), colour.data(), sym_scale.data(), sym_n.data(), symbols.data());
 }
@@ -314,14 +331,9 @@ void draw_panel(const Figure& fig, const Panel& p, double vx0, double vx1, doubl
   plslabelfunc(nullptr, nullptr);
   plmtex("b", 3.0, 0.5, 0.5, plplot_text(fig.xlabel).c_str());
   plmtex("l", ax.log ? 4.6 : 5.2, 0.5, 0.5, plplot_text(p.ylabel).c_str());
-  draw_legend(p, pal);
+  draw_legend(p, (vx1 - vx0) * fig.width, pal);
 }
 
-std::size_t glyphs(const std::string& markup) {
-  std::size_t n = 0;
-  for (unsigned char c : plain_text(markup)) n += (c & 0xC0) != 0x80;
-  return n;
-}
 
 // The title, shrunk to fit the page width; a title too long even then is split in two lines at
 // the ", " or ": " nearest its middle (outside braces, so no sub/superscript is cut).

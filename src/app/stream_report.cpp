@@ -198,7 +198,7 @@ BandFigure finite_n_figure(const Scene& scene, const ContactStream& s) {
   f.data_label = (expl ? "explicit geometry: " + std::to_string(s.spheres) + " spheres x " + std::to_string(s.rotations) +
                              " rotations"
                        : std::string("sampled from the exact law, no geometry")) +
-                 ", +-1 se between blocks (n = " + std::to_string(s.state.stats[0].n()) + ")";
+                 ", ±1 se between blocks (n = " + std::to_string(s.state.stats[0].n()) + ")";
   // Every 16th coarse edge in the bulk (the tails carry nothing at this scale).
   for (std::size_t j = 15; j < band.x.size(); j += 16) {
     if (band.x[j] > 4 * s.state.stats[0].ref.sigma) break;
