@@ -19,8 +19,9 @@
 // sphere's own law vs the ensemble law, ~quenched_deviation_scale(N)) and model
 // (sup |F_eq14 - F_exact|).
 //
-// Outputs in --out DIR: rve.csv (strategy,n,seconds,ks_D,mean_z,std_z), rve.gp + rve.png
-// (gnuplot; skipped with a warning if gnuplot is missing), and a markdown summary on stdout.
+// Outputs in --out DIR: rve-runs.csv (strategy,n,seconds,ks_D,mean_z,std_z), rve-pareto.csv, the
+// figure rve.png with its plotted data rve.csv (PLplot; skipped with a warning without it), and a
+// markdown summary on stdout.
 // The program re-reads and validates its CSV and exits non-zero if it is malformed.
 #include <algorithm>
 #include <boost/math/quadrature/gauss_kronrod.hpp>
@@ -42,6 +43,7 @@
 
 #include <omp.h>
 
+#include "asperity/app/plot.hpp"
 #include "asperity/experiments/ensemble.hpp"
 #include "asperity/core/random.hpp"
 #include "asperity/laws/statistics.hpp"
@@ -191,6 +193,68 @@ std::string fmt(double v, int prec = 3) {
   return b;
 }
 
+// The runs no other run beats in both time and error, fastest first.
+std::vector<Row> pareto_rows(std::vector<Row> rows) {
+  std::sort(rows.begin(), rows.end(), [](const Row& x, const Row& y) { return x.seconds < y.seconds; });
+  std::vector<Row> front;
+  double best = std::numeric_limits<double>::infinity();
+  for (const Row& r : rows)
+    if (r.D < best) best = r.D, front.push_back(r);
+  return front;
+}
+
+// KS distance against wall time, log-log: one line per strategy, the Pareto front, and the
+// quenched and model error scales as horizontal lines.
+asperity::Figure rve_figure(const std::vector<Row>& rows, const std::vector<Strategy>& strategies,
+                            const std::vector<Row>& front, double quenched, double model, std::uint64_t N, double R,
+                            double a, int threads) {
+  using namespace asperity;
+  Figure fig;
+  std::ostringstream t;
+  t << "Run time against error, N = " << N << ", R = " << R << " m, a = " << a << " m";
+  fig.title = t.str();
+  fig.xlabel = "wall time of the pipeline [s] (" + std::to_string(threads) + " threads)";
+  fig.log_x = true;
+  fig.width = 1100, fig.height = 750;
+  Panel p;
+  p.ylabel = "KS distance D of r_{xy} vs exact finite-N law";
+  p.log_y = true, p.grid = true;
+  double t_lo = std::numeric_limits<double>::infinity(), t_hi = 0;
+  for (std::size_t k = 0; k < strategies.size(); ++k) {
+    LineSeries l;
+    l.label = strategies[k].name;
+    l.colour = kOkabeIto[k % std::size(kOkabeIto)];
+    constexpr Dash dashes[] = {Dash::solid, Dash::dashed, Dash::dash_dot};
+    l.dash = dashes[(k / std::size(kOkabeIto)) % std::size(dashes)];  // 13 strategies, 6 colours
+    PointSeries pts;
+    pts.label = strategies[k].name + " (runs)";
+    pts.in_legend = false, pts.colour = l.colour;
+    for (const Row& r : rows)
+      if (r.strategy == strategies[k].name) {
+        l.x.push_back(r.seconds), l.y.push_back(r.D);
+        pts.x.push_back(r.seconds), pts.y.push_back(r.D), pts.se.push_back(0), pts.count.push_back(double(r.n));
+        t_lo = std::min(t_lo, r.seconds), t_hi = std::max(t_hi, r.seconds);
+      }
+    p.lines.push_back(std::move(l));
+    p.points.push_back(std::move(pts));
+  }
+  LineSeries pf;
+  pf.label = "Pareto front", pf.colour = kBlack, pf.dash = Dash::dashed, pf.width = 1;
+  for (const Row& r : front) pf.x.push_back(r.seconds), pf.y.push_back(r.D);
+  p.lines.push_back(std::move(pf));
+  if (!(t_hi > t_lo)) t_lo = 1e-3, t_hi = 1;
+  auto level = [&](const char* label, double y, Rgb c) {
+    LineSeries l;
+    l.label = label, l.colour = c, l.dash = Dash::dotted, l.width = 1.5;
+    l.x = {t_lo, t_hi}, l.y = {y, y};
+    p.lines.push_back(std::move(l));
+  };
+  level("quenched scale (one sphere)", quenched, {0xc0, 0x39, 0x2b});
+  level("model error Eq. 14", model, {0x1f, 0x4e, 0x9c});
+  fig.panels = {std::move(p)};
+  return fig;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -307,7 +371,7 @@ int main(int argc, char** argv) {
   }
 
   // --- CSV ------------------------------------------------------------------------------------
-  const fs::path csv = fs::path(o.out) / "rve.csv";
+  const fs::path csv = fs::path(o.out) / "rve-runs.csv";
   {
     std::ofstream f(csv);
     f << "strategy,n,seconds,ks_D,mean_z,std_z\n";
@@ -329,46 +393,19 @@ int main(int argc, char** argv) {
   // --- Pareto front (no other point is both faster and more accurate) + plot ------------------
   const fs::path pareto = fs::path(o.out) / "rve-pareto.csv";
   {
-    std::vector<Row> sorted = rows;
-    std::sort(sorted.begin(), sorted.end(), [](const Row& x, const Row& y) { return x.seconds < y.seconds; });
     std::ofstream f(pareto);
     f << "seconds,ks_D,strategy,n\n";
-    double best = std::numeric_limits<double>::infinity();
-    for (const Row& r : sorted)
-      if (r.D < best) {
-        best = r.D;
-        f << r.seconds << "," << r.D << "," << r.strategy << "," << r.n << "\n";
-      }
+    for (const Row& r : pareto_rows(rows)) f << r.seconds << "," << r.D << "," << r.strategy << "," << r.n << "\n";
   }
-  const fs::path gp = fs::path(o.out) / "rve.gp";
-  {
-    std::ofstream f(gp);
-    f << "set terminal pngcairo size 1100,750\n"
-      << "set output '" << (fs::path(o.out) / "rve.png").string() << "'\n"
-      << "set datafile separator ','\n"
-      << "set logscale xy\nset grid\nset format y '10^{%L}'\nset format x '10^{%L}'\n"
-      << "set xlabel 'wall time of the pipeline [s] (" << threads << " threads)'\n"
-      << "set ylabel 'KS distance D of r_{xy} vs exact finite-N law'\n"
-      << "set title 'Run time against error, N = " << N << ", R = " << R << " m, a = " << a << " m'\n"
-      << "set key outside right\n"
-      << "plot ";
-    bool first = true;
-    for (const Strategy& st : strategies) {
-      if (!first) f << ", \\\n     ";
-      first = false;
-      f << "'" << csv.string() << "' skip 1 using 3:(strcol(1) eq '" << st.name
-        << "' ? $4 : 1/0) with linespoints lw 2 title '" << st.name << "'";
+  // The figure, drawn in-process (app/plot.hpp): rve.png with its plotted data rve.csv.
+  if (const std::string why = asperity::plotting_problem(); !why.empty()) {
+    std::cerr << "warning: rve.png skipped: " << why << "\n";
+  } else {
+    try {
+      asperity::write_figure(o.out, "rve", rve_figure(rows, strategies, pareto_rows(rows), quenched, model, N, R, a, threads));
+    } catch (const std::exception& ex) {
+      std::cerr << "warning: rve.png not written: " << ex.what() << "\n";
     }
-    f << ", \\\n     '" << pareto.string()
-      << "' skip 1 using 1:2 with lines dt 2 lw 1 lc 'black' title 'Pareto front'"
-      << ", \\\n     '' skip 1 using 1:2 with points pt 6 ps 2.5 lc 'black' notitle"
-      << ", \\\n     " << quenched << " with lines dt 3 lc 'red' title 'quenched scale (one sphere)'"
-      << ", \\\n     " << model << " with lines dt 3 lc 'blue' title 'model error Eq. 14'\n";
-  }
-  if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
-    std::cerr << "warning: gnuplot not found, rve.png skipped (script: " << gp << ")\n";
-  } else if (std::system(("gnuplot '" + gp.string() + "'").c_str()) != 0) {
-    std::cerr << "warning: gnuplot failed on " << gp << ", rve.png not written\n";
   }
 
   // --- markdown summary ------------------------------------------------------------------------

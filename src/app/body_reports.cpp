@@ -2,6 +2,7 @@
 // Tables and report.json bodies of the experiments beyond the paper (radii, mesh impacts).
 #include "asperity/app/experiment_reports.hpp"
 
+#include "asperity/app/plot.hpp"
 #include "asperity/app/report.hpp"
 
 #include <nlohmann/json.hpp>
@@ -23,7 +24,8 @@ nlohmann::json json_of(const LawCheck& c) {
 void add_tests(nlohmann::json& j, const std::vector<LawCheck>& tests, const std::vector<std::string>& plots) {
   j["tests"] = nlohmann::json::array();
   for (const auto& t : tests) j["tests"].push_back(json_of(t));
-  j["plots"] = plots;
+  j["plots"] = image_files(plots);
+  j["plot_data"] = data_files(plots);
   j["rejected"] = decisive_rejection(tests);
   j["skipped"] = decisive_skipped(tests);
 }

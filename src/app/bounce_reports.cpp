@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// Tables, report.json bodies and gnuplot figures of bounce runs (spheres and mesh bodies).
+// Tables, report.json bodies and figures of bounce runs (spheres and mesh bodies).
 #include "asperity/app/experiment_reports.hpp"
 
 #include "asperity/app/report.hpp"
@@ -9,11 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <exception>
 #include <iomanip>
 #include <locale>
 #include <sstream>
-#include <thread>
 #include <vector>
 
 #include "asperity/app/plot.hpp"
@@ -24,14 +22,6 @@ namespace asperity {
 
 using detail::fmt;
 using detail::num;
-
-namespace {
-std::string gp_quote(std::string s) {  // inside '...' gnuplot only needs ' doubled
-  for (std::size_t i = s.find('\''); i != std::string::npos; i = s.find('\'', i + 2)) s.insert(i, 1, '\'');
-  return s;
-}
-
-}  // namespace
 
 std::string format_bounce_table(const std::vector<BounceVariantReport>& reports) {
   std::ostringstream o;
@@ -130,7 +120,8 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
   j["parameters"] = {{"asperities", sphere.asperities}, {"radius_m", sphere.radius}, {"asperity_radius_m", sphere.asperity_radius},
                      {"seed", seed}};
   j["rejected"] = false;
-  j["plots"] = plots;
+  j["plots"] = image_files(plots);
+  j["plot_data"] = data_files(plots);
   json variants = json::array();
   for (const auto& r : reports) {
     json v;
@@ -216,116 +207,106 @@ std::string bounce_to_json(const std::string& scene_name, const SphereParams& sp
 }
 
 namespace {
-// One variant's figure: its speed windows' histograms and fitted Eq. 2 densities.
-void write_bounce_plot(const std::filesystem::path& png, const BounceVariantReport& r, const std::vector<const BounceGroup*>& gs) {
-  auto script = [&](const std::filesystem::path& out) {
-    std::ostringstream s;
-    s.imbue(std::locale::classic());
-    s.precision(10);
-    static const char* colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9"};
-    double ymin = 1e300, ymax = 0, xlo = 1e300, xhi = -1e300;
-    for (std::size_t k = 0; k < gs.size(); ++k) {
-      const auto& g = *gs[k];
-      const auto& f = g.fit.law;
-      // eps - m in units of 1e-6, range from the 0.1% and 99.9% sample quantiles.
-      const double lo = (quantile_sorted(g.sorted, 0.001) - f.m) * 1e6, hi = (quantile_sorted(g.sorted, 0.999) - f.m) * 1e6;
-      std::vector<double> x(g.sorted.size());
-      for (std::size_t i = 0; i < x.size(); ++i) x[i] = (g.sorted[i] - f.m) * 1e6;
-      const auto h = make_histogram(x, lo, hi, 60);
-      s << "$h" << k << " << EOD\n";
-      for (std::size_t i = 0; i < h.bins(); ++i)
-        if (h.counts[i] > 0) {
-          s << h.centre(i) << ' ' << h.density(i) << ' ' << h.density_se(i) << '\n';
-          ymin = std::min(ymin, h.density(i)), ymax = std::max(ymax, h.density(i));
-        }
-      s << "EOD\n$f" << k << " << EOD\n";
-      for (int i = 0; i <= 400; ++i) {
-        const double t = lo + (hi - lo) * i / 400.0;
-        s << t << ' ' << f.pdf(f.m + t * 1e-6) * 1e-6 << '\n';
+// One variant's figure: its speed windows' histograms and fitted Eq. 2 densities, in units of
+// 1e-6 about each window's mode, on a log scale.
+Figure bounce_figure(const BounceVariantReport& r, const std::vector<const BounceGroup*>& gs) {
+  Figure fig;
+  fig.title = "Fig. 6, " + std::string(to_string(r.variant)) + ": impact-speed windows, fitted asymmetric Laplace (Eq. 2)";
+  fig.xlabel = "ε - ε_n(u) - m [10^{-6}]";
+  fig.height = 650;
+  Panel p;
+  p.ylabel = "probability density [1/10^{-6}]";
+  p.log_y = true;
+  p.legend = LegendAt::top_left;
+  double ymin = 1e300, ymax = 0;
+  for (std::size_t k = 0; k < gs.size(); ++k) {
+    const auto& g = *gs[k];
+    const auto& f = g.fit.law;
+    const Rgb colour = kOkabeIto[(k + 1) % std::size(kOkabeIto)];
+    // eps - m in units of 1e-6, range from the 0.1% and 99.9% sample quantiles.
+    const double lo = (quantile_sorted(g.sorted, 0.001) - f.m) * 1e6, hi = (quantile_sorted(g.sorted, 0.999) - f.m) * 1e6;
+    std::vector<double> x(g.sorted.size());
+    for (std::size_t i = 0; i < x.size(); ++i) x[i] = (g.sorted[i] - f.m) * 1e6;
+    const auto h = make_histogram(x, lo, hi, 60);
+    PointSeries pts;
+    pts.label = "u in [" + num(g.lo) + "," + num(g.hi) + "] m/s (n = " + std::to_string(g.n) + ")";
+    pts.colour = colour, pts.size = 0.8;
+    for (std::size_t i = 0; i < h.bins(); ++i)
+      if (h.counts[i] > 0) {
+        pts.x.push_back(h.centre(i)), pts.y.push_back(h.density(i)), pts.se.push_back(h.density_se(i));
+        pts.count.push_back(h.counts[i]);
+        ymin = std::min(ymin, h.density(i)), ymax = std::max(ymax, h.density(i));
       }
-      s << "EOD\n";
-      xlo = std::min(xlo, lo), xhi = std::max(xhi, hi);
+    LineSeries law;  // not in the legend: the window's colour says which fit it is
+    law.colour = colour, law.in_legend = false;
+    for (int i = 0; i <= 400; ++i) {
+      const double t = lo + (hi - lo) * i / 400.0;
+      law.x.push_back(t), law.y.push_back(f.pdf(f.m + t * 1e-6) * 1e-6);
     }
-    s << "set encoding utf8\nset terminal pngcairo size 900,650 enhanced font 'sans,12'\nset output '" << gp_quote(out.string()) << "'\n"
-      << "set logscale y\nset format y '10^{%L}'\nset xrange [" << xlo << ":" << xhi << "]\nset yrange [" << ymin / 3 << ":"
-      << ymax * 3 << "]\n"
-      << "set xlabel '{/Symbol e} - {/Symbol e}_n(u) - m [10^{-6}]'\nset ylabel 'probability density [1/10^{-6}]'\n"
-      << "set key top left\nset title 'Fig. 6, " << to_string(r.variant) << ": impact-speed windows, fitted asymmetric Laplace (Eq. 2)'\n"
-      << "plot ";
-    for (std::size_t k = 0; k < gs.size(); ++k) {
-      const auto& g = *gs[k];
-      const char* col = colours[k % 6];
-      s << (k ? ", \\\n  " : "") << "$h" << k << " using 1:2:3 with yerrorbars pointtype 7 pointsize 0.5 lc rgb '" << col
-        << "' title 'u in [" << g.lo << "," << g.hi << "] m/s (n = " << g.n << ")', $f" << k
-        << " using 1:2 with lines lw 2 lc rgb '" << col << "' notitle";
-    }
-    s << "\nunset output\n";
-    return s.str();
-  };
-  write_gnuplot_png(png, script);
+    law.label = "Eq. 2 fit, u in [" + num(g.lo) + "," + num(g.hi) + "] m/s";
+    p.points.push_back(std::move(pts));
+    p.lines.push_back(std::move(law));
+  }
+  if (ymax > 0) p.y_lo = ymin / 3, p.y_hi = ymax * 3;
+  fig.panels = {std::move(p)};
+  return fig;
 }
 }  // namespace
 
-std::vector<std::string> write_bounce_plots(const std::filesystem::path& dir, const std::vector<BounceVariantReport>& reports) {
+std::vector<std::string> write_bounce_plots(const std::filesystem::path& dir, const std::vector<BounceVariantReport>& reports,
+                                            const PlotFormats& formats) {
   std::vector<std::string> files;
-  std::vector<std::vector<const BounceGroup*>> groups;
-  std::vector<const BounceVariantReport*> of;
   for (const auto& r : reports) {
     std::vector<const BounceGroup*> gs;
     for (const auto& g : r.groups)
       if (g.by == "speed" && g.fitted) gs.push_back(&g);
     if (gs.empty()) continue;
-    files.push_back("fig6_" + std::string(to_string(r.variant)) + ".png");
-    groups.push_back(std::move(gs)), of.push_back(&r);
+    // A failure throws; the run's own clean-up removes the figures written before it.
+    const auto written = write_figure(dir, "fig6_" + std::string(to_string(r.variant)), bounce_figure(r, gs), formats);
+    files.insert(files.end(), written.begin(), written.end());
   }
-  // One gnuplot process per figure, side by side (as write_figures); the first failure in order
-  // is reported (the run's own cleanup removes the figures it wrote).
-  std::vector<std::exception_ptr> errors(files.size());
-  {
-    std::vector<std::thread> workers;
-    for (std::size_t i = 0; i < files.size(); ++i)
-      workers.emplace_back([&, i] {
-        try {
-          write_bounce_plot(dir / files[i], *of[i], groups[i]);
-        } catch (...) {
-          errors[i] = std::current_exception();
-        }
-      });
-    for (auto& w : workers) w.join();
-  }
-  for (const auto& e : errors)
-    if (e) std::rethrow_exception(e);
   return files;
 }
 
 namespace {
 
 // eps against impact speed: mean +- se and the 10/90% quantiles per speed bin, eps_n(u) of Eq. 9
-// (what a smooth sphere would give) for reference.
-void plot_eps_vs_speed(const std::filesystem::path& png, const BodyBounceReport& r, const BounceExperiment& b,
-                       const std::string& title) {
+// (what a smooth sphere would give) for reference. `title` is figure markup (user text escaped).
+Figure eps_vs_speed_figure(const BodyBounceReport& r, const BounceExperiment& b, const std::string& title) {
   const auto en = viscoelastic_pade14(b.beta);
-  write_gnuplot_png(png, [&](const std::filesystem::path& out) {
-    std::ostringstream o;
-    o.imbue(std::locale::classic());
-    o.precision(10);
-    o << "$m << EOD\n";
-    for (const auto& x : r.by_speed)
-      if (x.n >= 5)
-        o << 0.5 * (x.lo + x.hi) << ' ' << x.eps.value << ' ' << x.eps.se << ' ' << x.eps_q10 << ' ' << x.eps_q90 << '\n';
-    o << "EOD\n$n << EOD\n";
-    for (int i = 0; i <= 100; ++i) {
-      const double u = b.stop_speed + (b.speed - b.stop_speed) * i / 100.0;
-      o << u << ' ' << (*en)(u) << '\n';
+  Figure fig;
+  fig.title = title;
+  fig.xlabel = "impact speed u = -V_z [m/s]";
+  fig.height = 600;
+  Panel p;
+  p.ylabel = "ε = -V'_z/V_z";
+  p.legend = LegendAt::bottom_right;
+  p.grid = true;
+  p.y_lo = -0.5, p.y_hi = 3;
+  BandSeries band;
+  band.label = "10%-90% of impacts";
+  PointSeries mean;
+  mean.label = "mean ± se";
+  mean.colour = {0x00, 0x72, 0xB2};
+  mean.size = 1.2;
+  for (const auto& x : r.by_speed)
+    if (x.n >= 5) {
+      const double u = 0.5 * (x.lo + x.hi);
+      band.x.push_back(u), band.lo.push_back(x.eps_q10), band.hi.push_back(x.eps_q90);
+      mean.x.push_back(u), mean.y.push_back(x.eps.value), mean.se.push_back(x.eps.se), mean.count.push_back(double(x.n));
     }
-    o << "EOD\nset encoding utf8\nset terminal pngcairo size 900,600 enhanced font 'sans,12'\nset output '" << out.string()
-      << "'\nset title '" << title << "'\nset xlabel 'impact speed u = -V_z [m/s]'\nset ylabel '{/Symbol e} = -V''_z/V_z'\n"
-      << "set key bottom right\nset grid\nset yrange [-0.5:3]\n"
-      << "plot $m using 1:4:5 with filledcurves lc rgb '#cce0f0' title '10%-90% of impacts', \\\n"
-      << "  $m using 1:2:3 with yerrorbars pt 7 ps 0.8 lc rgb '#0072B2' title 'mean {/Symbol \\261} se', \\\n"
-      << "  $n using 1:2 with lines lw 2 lc rgb '#D55E00' title '{/Symbol e}_n(u), Eq. (9): smooth sphere'\nunset output\n";
-    return o.str();
-  });
+  LineSeries smooth;
+  smooth.label = "ε_n(u), Eq. (9): smooth sphere";
+  for (int i = 0; i <= 100; ++i) {
+    const double u = b.stop_speed + (b.speed - b.stop_speed) * i / 100.0;
+    smooth.x.push_back(u), smooth.y.push_back((*en)(u));
+  }
+  fig.x_lo = std::min(b.stop_speed, b.speed), fig.x_hi = std::max(b.stop_speed, b.speed);
+  p.bands = {std::move(band)};
+  p.points = {std::move(mean)};
+  p.lines = {std::move(smooth)};
+  fig.panels = {std::move(p)};
+  return fig;
 }
 
 }  // namespace
@@ -435,13 +416,21 @@ std::string to_json(const MeshBounceReport& r) {
   return j.dump(2) + "\n";
 }
 
-std::vector<std::string> write_mesh_bounce_plots(const std::filesystem::path& dir, const MeshBounceReport& r) {
-  std::vector<std::string> plots;
-  plot_eps_vs_speed(dir / "eps_vs_speed.png", r.report, r.experiment.options.bounce,
-                    "{/Symbol e} against impact speed: " + mesh_bounce_subtitle(r));
-  plots.push_back("eps_vs_speed.png");
-  for (const auto& f : write_figures(dir, r.figures)) plots.push_back(f);
-  for (const auto& f : write_bounce_plots(dir, {r.report.base})) plots.push_back(f);
+std::vector<std::string> write_mesh_bounce_plots(const std::filesystem::path& dir, const MeshBounceReport& r,
+                                                 const PlotFormats& formats) {
+  std::vector<std::string> plots =
+      write_figure(dir, "eps_vs_speed",
+                   eps_vs_speed_figure(r.report, r.experiment.options.bounce, "ε against impact speed: " + mesh_bounce_subtitle(r)), formats);
+  try {
+    for (const auto& f : write_figures(dir, r.figures, formats)) plots.push_back(f);
+    for (const auto& f : write_bounce_plots(dir, {r.report.base}, formats)) plots.push_back(f);
+  } catch (...) {
+    for (const auto& f : plots) {
+      std::error_code ec;
+      std::filesystem::remove(dir / f, ec);
+    }
+    throw;
+  }
   return plots;
 }
 

@@ -216,6 +216,7 @@ std::string checkpoint_key(const Scene& s) {
   Scene k = s;
   k.ensemble.threads = 0;
   k.plots = true;
+  k.plot_format = "png";  // figures change no result
   k.out = "DIR";  // the directory may be named differently (relative, absolute) when resumed
   // The resolved design too: a version that resolves "auto" differently must not continue it.
   const EnsembleConfig e = planned(s);

@@ -5,7 +5,6 @@
 #include <limits.h>
 #include <signal.h>
 #include <sys/syscall.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -31,14 +30,7 @@ struct Slot {
   char path[PATH_MAX] = {};
 };
 
-struct ChildSlot {
-  std::atomic<int> state{kFree};
-  std::atomic<long> creator{0};
-  std::atomic<pid_t> pgid{0};
-};
-
 Slot g_slots[kSlots];
-ChildSlot g_children[kSlots];  // figures render concurrently: one gnuplot per thread
 std::atomic<int> g_phase{0};    // 0 running, 1 deferred (renaming into place), 2 aborting
 std::atomic<int> g_pending{0};  // a signal that arrived while deferred
 std::atomic<bool> g_installed{false};
@@ -122,13 +114,6 @@ void remove_registered() {
   ::pthread_sigmask(SIG_BLOCK, &all, nullptr);
   const long self = this_thread_id();
   int budget_ms = 2000;
-  wait_for_creations(g_children, self, budget_ms);
-  for (auto& c : g_children) {
-    const pid_t child = c.pgid.load();
-    if (c.state.load() != kRegistered || child <= 0) continue;
-    ::kill(-child, SIGKILL);
-    ::waitpid(child, nullptr, 0);  // may find it reaped already (ECHILD): it is gone either way
-  }
   wait_for_creations(g_slots, self, budget_ms);
   using Kind = InterruptCleanup::Kind;
   for (auto& s : g_slots)
@@ -234,29 +219,6 @@ void InterruptCleanup::created() {
 
 InterruptCleanup::~InterruptCleanup() {
   if (slot_ >= 0) g_slots[slot_].state.store(kFree);
-}
-
-InterruptChild::InterruptChild() {
-  for (int i = 0; i < kSlots; ++i) {
-    int expected = kFree;
-    if (!g_children[i].state.compare_exchange_strong(expected, kWriting)) continue;
-    g_children[i].pgid.store(0);
-    g_children[i].creator.store(this_thread_id());
-    g_children[i].state.store(kCreating);
-    slot_ = i;
-    break;
-  }
-  if (g_phase.load() == 2) wait_for_exit();  // as for paths: spawn nothing the handler missed
-}
-
-void InterruptChild::started(pid_t pgid) {
-  if (slot_ < 0) return;
-  g_children[slot_].pgid.store(pgid);
-  g_children[slot_].state.store(kRegistered);
-}
-
-InterruptChild::~InterruptChild() {
-  if (slot_ >= 0) g_children[slot_].state.store(kFree);
 }
 
 void set_interrupt_output_committed() { g_committed.store(true); }

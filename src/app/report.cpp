@@ -692,7 +692,8 @@ std::string to_json(const GeometryReport& r) {
   j["skipped"] = r.skipped();
   j["timings_s"] = timings_json(r.timings_s);
   if (r.index_bytes) j["index_bytes_per_asperity"] = double(r.index_bytes) / double(e.sphere.asperities);
-  j["plots"] = r.plots;
+  j["plots"] = image_files(r.plots);
+  j["plot_data"] = data_files(r.plots);
   if (!r.plan.empty()) j["plan"] = plan_json(r.plan);
   if (!r.scene_toml.empty()) j["scene_file"] = r.scene_toml;
   return j.dump(2) + "\n";
@@ -739,7 +740,7 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
   std::ostringstream sub;
   const bool expl = scene.ensemble.mode == Mode::explicit_spheres;
   const std::uint64_t K = expl ? scene.ensemble.spheres : s.r_xy.size();
-  sub << "N = " << sp.asperities << ", {/Symbol r} = " << sp.asperity_radius << " m";
+  sub << "N = " << sp.asperities << ", ρ = " << sp.asperity_radius << " m";
   // The legend of the measured points names the ensemble they come from.
   const std::string data_label =
       expl ? "explicit geometry: " + std::to_string(K) + (K == 1 ? " sphere x " : " spheres x ") +
@@ -759,10 +760,10 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
       lo = radial ? 0.0 : -hi;
       const std::string sym = radial ? "r_{xy}" : (set.quantity == "r_x" ? "r_x" : "r_y");
       fig.title = sym + " of the contact vector: " + sub.str();
-      fig.xlabel = sym + " [{/Symbol m}m]";
+      fig.xlabel = sym + " [µm]";
       fig.x_scale = 1e6;
       fig.y_scale = 1e-6;
-      fig.ylabel = "probability density [1/{/Symbol m}m]";
+      fig.ylabel = "probability density [1/µm]";
     } else {
       // Range from the data: the bulk plus the tails the log panel shows.
       std::vector<double> v(x.begin(), x.end());
@@ -772,8 +773,8 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
       lo -= pad, hi += pad;
       if (!(hi > lo)) lo -= 1e-12, hi += 1e-12;
       const bool eps = set.quantity == "eps";
-      fig.title = (eps ? std::string("{/Symbol e}") : std::string("{/Symbol W}'_x")) + ": " + sub.str();
-      fig.xlabel = eps ? "{/Symbol e}" : "{/Symbol W}'_x [rad/s]";
+      fig.title = (eps ? std::string("ε") : std::string("Ω'_x")) + ": " + sub.str();
+      fig.xlabel = eps ? "ε" : "Ω'_x [rad/s]";
       fig.ylabel = eps ? "probability density" : "probability density [s/rad]";
     }
     fig.histogram = make_histogram(x, lo, hi, 60);
@@ -803,8 +804,7 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
     }
     figures.push_back({set.quantity + ".png", std::move(fig)});
   }
-  // One gnuplot process per figure, run concurrently (write_figures).
-  return write_figures(dir, figures);
+  return write_figures(dir, figures, parse_plot_formats(scene.plot_format));
 }
 
 }  // namespace asperity

@@ -150,7 +150,7 @@ SceneOutput run_radii(const Scene& s, const Progress& progress, const std::files
   RadiiReport r = run_radii_experiment(radii_experiment(s), progress);
   if (s.plots) {
     const auto t0 = Clock::now();
-    r.plots = write_figures(dir, r.figures);
+    r.plots = write_figures(dir, r.figures, parse_plot_formats(s.plot_format));
     r.seconds_plots = since(t0);
   }
   const bool lognormal = s.radii->radii.kind == RadiusDistribution::Kind::lognormal;
@@ -189,7 +189,7 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress, const std::filesy
   MeshImpactReport r = run_mesh_impacts(m, mesh, progress);
   if (s.plots) {
     const auto t0 = Clock::now();
-    r.plots = write_figures(dir, r.figures);
+    r.plots = write_figures(dir, r.figures, parse_plot_formats(s.plot_format));
     r.seconds_plots = since(t0);
   }
   o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());
@@ -231,7 +231,7 @@ SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* l
   const double seconds_analysis = since(t0);
   t0 = Clock::now();
   std::vector<std::string> plots;
-  if (s.plots) plots = write_bounce_plots(dir, reports);
+  if (s.plots) plots = write_bounce_plots(dir, reports, parse_plot_formats(s.plot_format));
   o.files = plots;
   const double seconds_plots = since(t0);
   o.table = table.str();
@@ -258,7 +258,7 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress, const std:
   MeshBounceReport r = run_mesh_bounces(m, mesh ? &*mesh : nullptr, progress);
   if (s.plots) {
     const auto t0 = Clock::now();
-    r.plots = write_mesh_bounce_plots(dir, r);
+    r.plots = write_mesh_bounce_plots(dir, r, parse_plot_formats(s.plot_format));
     r.seconds_plots = since(t0);
   }
   o.files.insert(o.files.end(), r.plots.begin(), r.plots.end());

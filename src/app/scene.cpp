@@ -35,11 +35,12 @@ Scene preset(std::string_view name) {
 
 namespace {
 
+// Figures are written as *.png, *.svg or *.pdf with their data as *.csv (app/plot.hpp).
 bool ends_with_png(const std::string& name) {
   if (name.size() < 4) return false;
   std::string ext = name.substr(name.size() - 4);
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".png";
+  return ext == ".png" || ext == ".svg" || ext == ".pdf" || ext == ".csv";
 }
 
 // A name for a message: control characters (a NUL, a newline) shown as \xNN.
@@ -99,7 +100,7 @@ void validate_outputs(const Scene& s) {
     throw std::invalid_argument("outputs.report: \"" + printable(s.report) + "\" " + why);
   const std::string table = report_table_name(s.report);
   if (ends_with_png(s.report))
-    throw std::invalid_argument("outputs.report: \"" + s.report + "\" would collide with the figures (*.png)");
+    throw std::invalid_argument("outputs.report: \"" + s.report + "\" would collide with the figures (*.png, *.svg, *.pdf, *.csv)");
   if (s.mesh && !s.mesh->export_ply.empty()) {
     const std::string& ply = s.mesh->export_ply;
     if (const std::string why = output_name_problem(ply); !why.empty())
@@ -108,7 +109,7 @@ void validate_outputs(const Scene& s) {
       throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" is also the name of the report" +
                                   (ply == table ? "'s table (" + s.report + " -> " + table + ")" : std::string()));
     if (ends_with_png(ply))
-      throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" would collide with the figures (*.png)");
+      throw std::invalid_argument("outputs.export_ply: \"" + ply + "\" would collide with the figures (*.png, *.svg, *.pdf, *.csv)");
   }
   if (s.cor_table) validate_cor_table(s);
 }

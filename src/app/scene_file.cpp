@@ -4,6 +4,7 @@
 
 #include "asperity/app/bounded_read.hpp"
 #include "asperity/app/output_staging.hpp"
+#include "asperity/app/plot.hpp"
 
 #define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
 #include <toml++/toml.h>
@@ -766,6 +767,14 @@ void read_outputs(Reader& top, Scene& s, bool impacts) {
   if (!s.bounce.enabled && !s.contact_stats && !(impacts && s.restitution_stats))
     out->bad("contact", "nothing to compute: request contact = true, or restitution = true with an impact experiment");
   if (auto p = out->boolean("plots")) s.plots = *p;
+  if (auto f = out->text("plot_format")) {
+    try {
+      parse_plot_formats(*f);
+    } catch (const std::invalid_argument& ex) {
+      out->bad("plot_format", ex.what());
+    }
+    s.plot_format = *f;
+  }
   if (auto a = out->real("alpha")) {
     if (!(*a > 0 && *a < 1)) out->bad("alpha", "must be in (0, 1), got " + num(*a));
     s.alpha = *a;
@@ -1104,7 +1113,9 @@ void write_outputs(std::ostream& os, const Scene& s) {
   os << "[outputs]\ncontact = " << (s.contact_stats ? "true" : "false") << "\n";
   if (s.ensemble.impact.enabled || !s.restitution_stats)
     os << "restitution = " << (s.restitution_stats ? "true" : "false") << "\n";
-  os << "plots = " << (s.plots ? "true" : "false") << "\nalpha = " << num(s.alpha) << "\ndir = " << quote(s.out.string())
+  os << "plots = " << (s.plots ? "true" : "false") << "\n";
+  if (s.plot_format != "png") os << "plot_format = " << quote(s.plot_format) << "\n";
+  os << "alpha = " << num(s.alpha) << "\ndir = " << quote(s.out.string())
      << "\nreport = " << quote(s.report) << "\n";
   if (s.mesh && !s.mesh->export_ply.empty())
     os << "export_ply = " << quote(s.mesh->export_ply) << "\nexport_style = \""

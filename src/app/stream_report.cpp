@@ -191,14 +191,14 @@ BandFigure finite_n_figure(const Scene& scene, const ContactStream& s) {
   const CdfBand band = pooled_cdf(s.state.stats[0]);
   BandFigure f;
   f.title = "finite-N correction of Eq. (14): N = " + std::to_string(sp.asperities);
-  f.xlabel = "r_{xy} [{/Symbol m}m]";
+  f.xlabel = "r_{xy} [µm]";
   f.ylabel = "F(r_{xy}) - F_{Eq. 14}(r_{xy})";
   f.x_scale = 1e6;
   const bool expl = scene.ensemble.mode == Mode::explicit_spheres;
   f.data_label = (expl ? "explicit geometry: " + std::to_string(s.spheres) + " spheres x " + std::to_string(s.rotations) +
                              " rotations"
                        : std::string("sampled from the exact law, no geometry")) +
-                 ", +-1 se between blocks (n = " + std::to_string(s.state.stats[0].n()) + ")";
+                 ", ±1 se between blocks (n = " + std::to_string(s.state.stats[0].n()) + ")";
   // Every 16th coarse edge in the bulk (the tails carry nothing at this scale).
   for (std::size_t j = 15; j < band.x.size(); j += 16) {
     if (band.x[j] > 4 * s.state.stats[0].ref.sigma) break;
@@ -211,39 +211,6 @@ BandFigure finite_n_figure(const Scene& scene, const ContactStream& s) {
                                    "predicted: exact finite-N law - Eq. (14)", 0, hi, 300));
   f.curves.push_back(sampled_curve([](double) { return 0.0; }, "Eq. (14)", 0, hi, 2));
   return f;
-}
-
-void write_band_png(const std::filesystem::path& png, const BandFigure& fig) {
-  write_gnuplot_png(png, [&](const std::filesystem::path& out) {
-    std::ostringstream s;
-    s.imbue(std::locale::classic());
-    s << std::setprecision(12) << "$pts << EOD\n";
-    for (std::size_t i = 0; i < fig.x.size(); ++i)
-      s << fig.x[i] * fig.x_scale << ' ' << fig.y[i] * fig.y_scale << ' ' << fig.se[i] * fig.y_scale << '\n';
-    s << "EOD\n";
-    for (std::size_t k = 0; k < fig.curves.size(); ++k) {
-      s << "$c" << k << " << EOD\n";
-      for (std::size_t i = 0; i < fig.curves[k].x.size(); ++i)
-        s << fig.curves[k].x[i] * fig.x_scale << ' ' << fig.curves[k].y[i] * fig.y_scale << '\n';
-      s << "EOD\n";
-    }
-    auto text = [](const std::string& t) {
-      std::string o = "\"";
-      for (char c : t) o += c == '"' || c == '\\' ? std::string("\\") + c : std::string(1, c);
-      return o + "\"";
-    };
-    std::string path = "'";
-    for (char c : out.string()) path += c == '\'' ? std::string("''") : std::string(1, c);
-    s << "set encoding utf8\nset terminal pngcairo size 900,720 enhanced font 'sans,12'\nset output " << path << "'\n"
-      << "set title " << text(fig.title) << "\nset xlabel " << text(fig.xlabel) << "\nset ylabel " << text(fig.ylabel)
-      << "\nset key below Left reverse\nset grid\nplot $pts using 1:2:3 with yerrorbars pt 7 ps 0.6 lc rgb '#1f4e9c' title "
-      << text(fig.data_label);
-    const char* colours[] = {"#c0392b", "#555555"};
-    for (std::size_t k = 0; k < fig.curves.size(); ++k)
-      s << ", $c" << k << " with lines lw 2 lc rgb '" << colours[k % 2] << "' title " << text(fig.curves[k].label);
-    s << "\n";
-    return s.str();
-  });
 }
 
 namespace {
@@ -365,12 +332,13 @@ GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progr
   plan.stage("analysis").seconds = r.timings_s.back().second;
   plan.stage("analysis").reason = "contact laws of r_xy, r_x, r_y on the streamed histograms (" + streaming_label(run.ensemble) + ")";
   if (plan.runs("plots")) {
-    plan.stage("plots").reason = "outputs.plots: streaming keeps no drops, so one figure: finite_n.png (measured F - F_Eq14 "
+    plan.stage("plots").reason = "outputs.plots: streaming keeps no drops, so one figure: finite_n.png and .csv (measured F - F_Eq14 "
                                  "of r_xy with its band between blocks, against the exact finite-N law)";
-    if (plotting_available()) {
+    // validate-geometry refuses a run that asks for figures it cannot draw; a library caller
+    // without PLplot gets the report without the figure.
+    if (const PlotFormats formats = parse_plot_formats(run.plot_format); plotting_problem(formats).empty()) {
       t0 = std::chrono::steady_clock::now();
-      write_band_png((dir.empty() ? run.out : dir) / "finite_n.png", finite_n_figure(run, cs));
-      r.plots.push_back("finite_n.png");
+      r.plots = write_figure(dir.empty() ? run.out : dir, "finite_n", band_figure(finite_n_figure(run, cs)), formats);
       r.timings_s.emplace_back("plots", since(t0));
       plan.stage("plots").seconds = r.timings_s.back().second;
     }

@@ -363,10 +363,8 @@ namespace {
 }  // namespace
 
 std::string mesh_bounce_subtitle(const MeshBounceReport& r) {
-  std::string shown = r.body_name;  // '_' would be a subscript in gnuplot's enhanced text
-  std::replace(shown.begin(), shown.end(), '_', ' ');
-  std::ostringstream sub;
-  sub << shown << ", N = " << r.experiment.asperities << ", " << r.experiment.options.bounce.sequences << " sequences";
+  std::ostringstream sub;  // the body's name (a mesh file's) as written, not as figure markup
+  sub << figure_text_literal(r.body_name) << ", N = " << r.experiment.asperities << ", " << r.experiment.options.bounce.sequences << " sequences";
   return sub.str();
 }
 
@@ -413,9 +411,9 @@ MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e, const TriangleM
       const double lo = quantile_sorted(x, 0.001), hi = quantile_sorted(x, 0.999);
       const double pad = 0.02 * (hi - lo) + 1e-9;
       HistogramFigure fig;
-      fig.title = "{/Symbol e}, u in [" + fmt("%.2f", g.lo) + ", " + fmt("%.2f", g.hi) + "] m/s: " + sub + " (n = " +
+      fig.title = "ε, u in [" + fmt("%.2f", g.lo) + ", " + fmt("%.2f", g.hi) + "] m/s: " + sub + " (n = " +
                   std::to_string(x.size()) + ")";
-      fig.xlabel = "{/Symbol e} = -V'_z/V_z";
+      fig.xlabel = "ε = -V'_z/V_z";
       fig.histogram = make_histogram(x, lo - pad, hi + pad, 40);
       const std::string name = "eps_u" + fmt("%.2f", g.lo) + "-" + fmt("%.2f", g.hi) + ".png";
       r.figures.push_back({name, std::move(fig)});

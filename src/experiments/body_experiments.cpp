@@ -159,14 +159,14 @@ RadiiReport finish_lognormal(const RadiiExperiment& e, RadiiReport& r, const std
     t << "r_x, N = " << e.asperities << ", radii " << e.radii.describe() << ", " << rx.size() << " drops of " << e.screen_bodies
       << " spheres";
     fig.title = t.str();
-    fig.xlabel = "r_x [{/Symbol m}m]";
-    fig.ylabel = "probability density [1/{/Symbol m}m]";
+    fig.xlabel = "r_x [µm]";
+    fig.ylabel = "probability density [1/µm]";
     fig.x_scale = 1e6;
     fig.y_scale = 1e-6;
     fig.histogram = make_histogram(rx, -hi, hi, 60);
-    fig.curves.push_back(curve_of(gaussian_rx(r.lambda, "g"), "Eq. (18), {/Symbol l} of all asperities", -hi, hi));
+    fig.curves.push_back(curve_of(gaussian_rx(r.lambda, "g"), "Eq. (18), λ of all asperities", -hi, hi));
     if (r.lambda_eff.value > 0)
-      fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), {/Symbol l}_{eff} (screening)", -hi, hi));
+      fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), λ_{eff} (screening)", -hi, hi));
     fig.curves.push_back(curve_of(gaussian_rx(r.lambda_fit, "g"), "Gaussian, fitted variance", -hi, hi));
     r.figures.push_back({"r_x.png", std::move(fig)});
   }
@@ -291,16 +291,16 @@ HistogramFigure level_figure(const RadiiExperiment& e, const ExplicitDrops& x, c
   t << "r_x, N = " << e.asperities << ", radii " << e.radii.describe() << ", " << e.drops
     << " fresh drops (sampled from the exact law)";
   fig.title = t.str();
-  fig.xlabel = "r_x [{/Symbol m}m]";
-  fig.ylabel = "probability density [1/{/Symbol m}m]";
+  fig.xlabel = "r_x [µm]";
+  fig.ylabel = "probability density [1/µm]";
   fig.x_scale = 1e6;
   fig.y_scale = 1e-6;
   fig.histogram = make_histogram(x.rx, -hi, hi, 60);
   fig.curves.push_back(curve_of(levels_sphere_rx(e.asperities, e.radius, e.radii), "exact law, level radii", -hi, hi));
-  fig.curves.push_back(curve_of(gaussian_rx(r.lambda, "gauss-lambda"), "Eq. (18), {/Symbol l} of all asperities", -hi, hi));
+  fig.curves.push_back(curve_of(gaussian_rx(r.lambda, "gauss-lambda"), "Eq. (18), λ of all asperities", -hi, hi));
   if (r.lambda_eff.value > 0)
-    fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), {/Symbol l}_{eff} (screening)", -hi, hi));
-  fig.curves.push_back(curve_of(gaussian_rx(r.lambda_top, "gauss-lambda-top"), "Eq. (18), {/Symbol l} of the largest level", -hi, hi));
+    fig.curves.push_back(curve_of(gaussian_rx(r.lambda_eff.value, "g"), "Eq. (18), λ_{eff} (screening)", -hi, hi));
+  fig.curves.push_back(curve_of(gaussian_rx(r.lambda_top, "gauss-lambda-top"), "Eq. (18), λ of the largest level", -hi, hi));
   return fig;
 }
 
@@ -554,12 +554,12 @@ HistogramFigure rx_figure(const MeshDrops& D, const MeshImpactReport& r, const L
   const double hi = std::max(4.0 * sigma, std::max(std::abs(quantile_sorted(v, 0.001)), std::abs(quantile_sorted(v, 0.999))));
   HistogramFigure fig;
   fig.title = "r_x: " + sub;
-  fig.xlabel = "r_x [{/Symbol m}m]";
-  fig.ylabel = "probability density [1/{/Symbol m}m]";
+  fig.xlabel = "r_x [µm]";
+  fig.ylabel = "probability density [1/µm]";
   fig.x_scale = 1e6;
   fig.y_scale = 1e-6;
   fig.histogram = make_histogram(D.rx, -hi, hi, 80);
-  fig.curves.push_back(curve_of(l18, "Eq. (18), sphere of equal volume, same {/Symbol l}", -hi, hi));
+  fig.curves.push_back(curve_of(l18, "Eq. (18), sphere of equal volume, same λ", -hi, hi));
   return fig;
 }
 
@@ -570,8 +570,8 @@ HistogramFigure eps_figure(const MeshDrops& D, const ImpactScene& sc, const Law&
   lo = std::min(lo, par.eps_max - 6 * (par.eps_max - par.eps_n + 1e-3));
   hi = std::max(hi, par.eps_max) + 0.02 * (hi - lo);
   HistogramFigure fig;
-  fig.title = "{/Symbol e}: " + sub;
-  fig.xlabel = "{/Symbol e}";
+  fig.title = "ε: " + sub;
+  fig.xlabel = "ε";
   fig.histogram = make_histogram(D.e_ok, lo, hi, 80);
   fig.curves.push_back(curve_of(law, "Eq. (28) corrected, sphere of equal volume", lo, hi));
   return fig;
@@ -612,7 +612,7 @@ MeshImpactReport run_mesh_impacts(const MeshImpactExperiment& e, const TriangleM
   ts = std::chrono::steady_clock::now();
   if (e.plots) {
     std::ostringstream sub;
-    sub << e.mesh.stem().string() << (e.smooth_ellipsoid.empty() ? " (facets)" : " (smooth)") << ", N = " << e.asperities
+    sub << figure_text_literal(e.mesh.stem().string()) << (e.smooth_ellipsoid.empty() ? " (facets)" : " (smooth)") << ", N = " << e.asperities
         << ", " << e.radii.describe() << ", " << e.bodies << " x " << M;
     r.figures.push_back({"r_x.png", rx_figure(D, r, l18, sub.str())});
     if (!eps_laws.empty()) r.figures.push_back({"eps.png", eps_figure(D, sc, eps_laws.front(), sub.str())});

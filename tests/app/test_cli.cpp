@@ -13,6 +13,7 @@
 #include <set>
 #include <string>
 
+#include "asperity/app/plot.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "app/cli/progress_line.hpp"
 #include "run_command.hpp"
@@ -149,11 +150,17 @@ TEST(Cli, OneSphereIsReportedAsItsOwnLawAndDecidesNothing) {
 }
 
 TEST(Cli, FiguresAreWrittenWhenAsked) {
-  if (std::system("gnuplot -e 'set terminal pngcairo' >/dev/null 2>&1") != 0) GTEST_SKIP() << "no gnuplot";
+  if (!asperity::plotting_available()) GTEST_SKIP() << asperity::plotting_problem();
   const fs::path out = fresh_dir("plots");
   const CliRun r = run("--asperities 1000 --drops 5000 --out " + out.string());
   ASSERT_EQ(r.status, 0) << r.out;
   for (const char* p : {"r_xy.png", "r_x.png", "r_y.png"}) EXPECT_GT(fs::file_size(out / p), 10000u) << p;
+  // The plotted data beside each figure, listed in the report apart from the images.
+  for (const char* p : {"r_xy.csv", "r_x.csv", "r_y.csv"}) EXPECT_GT(fs::file_size(out / p), 1000u) << p;
+  std::ifstream f(out / "report.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j["plots"], nlohmann::json({"r_xy.png", "r_x.png", "r_y.png"}));
+  EXPECT_EQ(j["plot_data"], nlohmann::json({"r_xy.csv", "r_x.csv", "r_y.csv"}));
   fs::remove_all(out);
 }
 

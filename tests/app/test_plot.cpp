@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-// write_histogram_png: a Gaussian histogram against its pdf renders to a real PNG; failures throw
-// and leave nothing behind; invalid figures are rejected before gnuplot runs.
+// Figures (app/plot.hpp): a Gaussian histogram against its pdf renders to a real PNG (and SVG,
+// PDF) with its data as CSV; failures throw and leave nothing behind; invalid figures are rejected
+// before anything is drawn; hostile labels draw glyphs and nothing else.
 #include "asperity/app/plot.hpp"
+
+#include "app/plot_render.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +14,11 @@
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace asperity;
@@ -74,50 +80,169 @@ bool dir_has_only(const fs::path& dir, std::size_t n) {
   return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator())) == n;
 }
 
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+bool is_png(const fs::path& p) { return slurp(p).rfind(std::string("\x89PNG\r\n\x1a\n", 8), 0) == 0; }
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
+
+std::set<std::string> listing(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) names.insert(fs::relative(e.path(), dir).string());
+  return names;
+}
+
 }  // namespace
 
-TEST(Plot, GaussianHistogramPng) {
-  if (!plotting_available()) GTEST_SKIP() << "gnuplot with pngcairo not available";
+TEST(Plot, GaussianHistogramPngAndItsData) {
+  if (!plotting_available()) GTEST_SKIP() << plotting_problem();
   TempDir dir;
   const fs::path png = dir.path / "gaussian.png";
   // First a smaller figure, then overwrite it with the full one (rename onto an existing file).
   ASSERT_NO_THROW(write_histogram_png(png, gaussian_figure(20000)));
-  ASSERT_NO_THROW(write_histogram_png(png, gaussian_figure()));
+  const auto fig = gaussian_figure();
+  ASSERT_NO_THROW(write_histogram_png(png, fig));
   ASSERT_TRUE(fs::is_regular_file(png));
   EXPECT_GT(fs::file_size(png), 10u * 1024u);
-  std::ifstream in(png, std::ios::binary);
-  char sig[8] = {};
-  in.read(sig, 8);
-  const unsigned char expected[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  for (int i = 0; i < 8; ++i) EXPECT_EQ(static_cast<unsigned char>(sig[i]), expected[i]) << "byte " << i;
-  EXPECT_TRUE(dir_has_only(dir.path, 1)) << "temporary file left beside the PNG";
+  EXPECT_TRUE(is_png(png));
+  EXPECT_EQ(listing(dir.path), (std::set<std::string>{"gaussian.png", "gaussian.csv"})) << "temporary file left";
+  // The CSV: a header naming the axes with units, one row per bin, then one per curve point.
+  const auto rows = lines_of(slurp(dir.path / "gaussian.csv"));
+  ASSERT_FALSE(rows.empty());
+  EXPECT_EQ(rows[0], "series,r_x [µm],probability density [µm^-1],se [µm^-1],count");
+  EXPECT_EQ(rows.size(), 1 + fig.histogram.bins() + fig.curves[0].x.size() + fig.curves[1].x.size());
+  // The first bin: centre in µm, density in 1/µm, its se and its count, as plotted.
+  std::istringstream first(rows[1]);
+  std::vector<std::string> cells;
+  for (std::string c; std::getline(first, c, ',');) cells.push_back(c);
+  ASSERT_EQ(cells.size(), 5u) << rows[1];
+  EXPECT_EQ(cells[0], "explicit geometry (n = 10^5)");
+  EXPECT_NEAR(std::stod(cells[1]), fig.histogram.centre(0) * 1e6, 1e-9);
+  EXPECT_NEAR(std::stod(cells[2]), fig.histogram.density(0) * 1e-6, 1e-12);
+  EXPECT_EQ(std::stod(cells[4]), fig.histogram.counts[0]);
+  EXPECT_EQ(rows.back().rfind("\"Gaussian, σ = 1.15 µm\",", 0), 0u) << rows.back();
   if (std::getenv("ASPERITY_KEEP_PLOTS")) std::printf("kept %s\n", png.c_str());
 }
 
+TEST(Plot, SvgAndPdfBesideThePng) {
+  const std::string problem = plotting_problem(parse_plot_formats("png+svg+pdf"));
+  if (!problem.empty()) GTEST_SKIP() << problem;
+  TempDir dir;
+  const auto files = write_figure(dir.path, "g", histogram_figure(gaussian_figure(5000)), parse_plot_formats("png+svg+pdf"));
+  EXPECT_EQ(files, (std::vector<std::string>{"g.png", "g.svg", "g.pdf", "g.csv"}));
+  EXPECT_TRUE(is_png(dir.path / "g.png"));
+  EXPECT_NE(slurp(dir.path / "g.svg").find("<svg"), std::string::npos);
+  EXPECT_EQ(slurp(dir.path / "g.pdf").rfind("%PDF-", 0), 0u);
+  EXPECT_EQ(image_files(files), (std::vector<std::string>{"g.png", "g.svg", "g.pdf"}));
+  EXPECT_EQ(data_files(files), (std::vector<std::string>{"g.csv"}));
+}
+
+TEST(Plot, FormatsParseAndRefuse) {
+  EXPECT_EQ(to_string(parse_plot_formats("png")), "png");
+  EXPECT_EQ(to_string(parse_plot_formats("png+pdf")), "png+pdf");
+  EXPECT_EQ(to_string(parse_plot_formats("svg")), "svg");
+  for (const char* bad : {"", "jpg", "png+", "+png", "png+png", "PNG", "png pdf"})
+    EXPECT_THROW(parse_plot_formats(bad), std::invalid_argument) << bad;
+}
+
 TEST(Plot, FailureThrowsAndLeavesNothing) {
-  if (!plotting_available()) GTEST_SKIP() << "gnuplot with pngcairo not available";
+  if (!plotting_available()) GTEST_SKIP() << plotting_problem();
   TempDir dir;
   const fs::path png = dir.path / "no-such-dir" / "fig.png";
   try {
     write_histogram_png(png, gaussian_figure(1000));
     FAIL() << "expected std::runtime_error";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("gnuplot"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cannot write"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(png));
   EXPECT_FALSE(fs::exists(png.parent_path()));
   EXPECT_TRUE(dir_has_only(dir.path, 0));
 }
 
-TEST(Plot, QuotesInLabelsAreEscaped) {
-  if (!plotting_available()) GTEST_SKIP() << "gnuplot with pngcairo not available";
-  TempDir dir;
-  auto fig = gaussian_figure(5000);
-  fig.title = "a \"quoted\" title with a backslash \\ and 'single' quotes";
-  fig.curves[0].label = "say \"hi\"";
-  const fs::path png = dir.path / "it's \"quoted\".png";
-  ASSERT_NO_THROW(write_histogram_png(png, fig));
-  EXPECT_TRUE(fs::is_regular_file(png));
+// A symlink planted at the figure's name is replaced, never followed: its target is untouched.
+TEST(Plot, APlantedSymlinkIsNotFollowed) {
+  if (!plotting_available()) GTEST_SKIP() << plotting_problem();
+  TempDir dir, outside;
+  std::ofstream(outside.path / "victim") << "keep";
+  fs::create_symlink(outside.path / "victim", dir.path / "fig.png");
+  fs::create_symlink(outside.path / "victim", dir.path / "fig.csv");
+  ASSERT_NO_THROW(write_histogram_png(dir.path / "fig.png", gaussian_figure(1000)));
+  EXPECT_EQ(slurp(outside.path / "victim"), "keep");
+  EXPECT_FALSE(fs::is_symlink(dir.path / "fig.png"));
+  EXPECT_TRUE(is_png(dir.path / "fig.png"));
+  EXPECT_FALSE(fs::is_symlink(dir.path / "fig.csv"));
+}
+
+// Labels are data: every metacharacter of the shell, of gnuplot and of PLplot's text escapes in
+// titles, labels, legends and file names draws glyphs and runs nothing; no file appears but the
+// figure's own, and the canary a payload would create does not exist.
+TEST(Plot, HostileLabelsRunNothingAndWriteOnlyTheFigure) {
+  if (!plotting_available()) GTEST_SKIP() << plotting_problem();
+  TempDir dir, outside;
+  const std::string canary = (outside.path / "canary").string();
+  const std::vector<std::string> payloads = {
+      "`touch " + canary + "`", "$(touch " + canary + ")", "'; system 'touch " + canary + "'; print '",
+      "\"; system(\"touch " + canary + "\"); print \"", "; touch " + canary + ";", "| touch " + canary,
+      "&& touch " + canary + " &", "> " + canary, "< /etc/passwd", "${HOME} $PATH ~ * ? [a-z] ! \\",
+      "#u#d#g#f#b#+#-#(123)#(2200)#[0x41]#[0xffffffff]#<0x10>#<sans/>##", "% %n %s %x %p %99999999d",
+      "<b>&amp;</b> <span foreground='red'>pango</span> &#38; &lt;", "{/Symbol a} {/=99 big} @x ^{^{^{_{_{}}}}}} \\\\ \\",
+      std::string(3000, '#'), std::string(2000, 'x') + "_{" + std::string(2000, 'y'),
+      "\xFF\xFE invalid \xC3 utf-8 \xE2\x82", "plot 'x' with lines; set output '" + canary + "'"};
+  auto fig = gaussian_figure(3000);
+  int k = 0;
+  for (const auto& p : payloads) {
+    fig.title = "title " + p;
+    fig.xlabel = p;
+    fig.ylabel = figure_text_literal(p);
+    fig.data_label = p;
+    fig.curves[0].label = figure_text_literal(p);
+    fig.curves[1].label = p + p;
+    const std::string stem = "fig" + std::to_string(k++) + " it's \"q\" $(x) `y` ; #";
+    ASSERT_NO_THROW(write_figure(dir.path, stem, histogram_figure(fig), parse_plot_formats("png+svg"))) << p;
+    EXPECT_TRUE(is_png(dir.path / (stem + ".png"))) << p;
+  }
+  std::set<std::string> expected;
+  for (int i = 0; i < k; ++i)
+    for (const char* ext : {".png", ".svg", ".csv"})
+      expected.insert("fig" + std::to_string(i) + " it's \"q\" $(x) `y` ; #" + ext);
+  EXPECT_EQ(listing(dir.path), expected);
+  EXPECT_TRUE(listing(outside.path).empty()) << "a payload created a file";
+  EXPECT_FALSE(fs::exists(canary));
+  EXPECT_FALSE(fs::exists(fs::current_path() / "canary"));
+}
+
+// The conversion to PLplot text emits no escape but #u, #d and ##, and stays inside PLplot's
+// fixed text buffers (500 code points in the cairo driver).
+TEST(Plot, TextConversionEmitsOnlyGlyphsAndSubSuperscripts) {
+  using detail::plain_text;
+  using detail::plplot_text;
+  EXPECT_EQ(plplot_text("r_{xy} [µm]"), "r#dxy#u [µm]");
+  EXPECT_EQ(plplot_text("10^{-6}, V'_z"), "10#u-6#d, V'#dz#u");
+  EXPECT_EQ(plplot_text("#u#(123)"), "##u##(123)");
+  EXPECT_EQ(plplot_text(figure_text_literal("a_b^c{d}\\e#")), "a_b^c{d}\\e##");
+  EXPECT_EQ(plplot_text("tab\there\x01"), "tab?here?");
+  EXPECT_EQ(plplot_text("\xFF"), "?");
+  EXPECT_EQ(plain_text("r_{xy} [µm^{-1}]"), "r_xy [µm^-1]");
+  for (const std::string& s : {std::string(5000, '#'), std::string(5000, 'a'), "^{" + std::string(5000, '_'),
+                               std::string(2000, '\\') + "#"}) {
+    const std::string t = plplot_text(s);
+    EXPECT_LE(t.size(), 440u);
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (t[i] == '#') {
+        ASSERT_LT(i + 1, t.size()) << "a lone # at the end";
+        EXPECT_TRUE(t[i + 1] == '#' || t[i + 1] == 'u' || t[i + 1] == 'd') << t.substr(i, 2);
+        ++i;
+      }
+  }
 }
 
 TEST(Plot, InvalidFiguresAreRejected) {

@@ -1,13 +1,11 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // What a run leaves behind when it is interrupted: nothing. install_interrupt_cleanup() makes
-// SIGINT, SIGTERM, SIGHUP and SIGPIPE kill the registered child process group (gnuplot), remove
-// the registered temporary directories (their files, then themselves) and the registered output
-// directories the run created (only if empty), and exit with status 128 + signal number. The
+// SIGINT, SIGTERM, SIGHUP and SIGPIPE remove the registered temporary files and directories
+// (their files, then themselves) and the registered output directories the run created (only if
+// empty), and exit with status 128 + signal number. The
 // handler uses async-signal-safe system calls only; registration is lock-free. Without
 // install_interrupt_cleanup() (a library user) registrations cost a few stores and do nothing.
-#include <sys/types.h>
-
 #include <filesystem>
 
 namespace asperity {
@@ -22,7 +20,7 @@ void install_interrupt_cleanup(const char* program);
 class InterruptCleanup {
  public:
   enum class Kind {
-    directory,        ///< its files, then itself (a staging directory, gnuplot's private directory)
+    directory,        ///< its files, then itself (a staging directory)
     empty_directory,  ///< only if empty (a directory the run created for its output)
     file              ///< a temporary file
   };
@@ -34,21 +32,6 @@ class InterruptCleanup {
 
  private:
   int slot_ = -1;  ///< -1: no free slot (too many at once): not cleaned on a signal
-};
-
-/// A child process (gnuplot, in its own process group) killed on a signal while the guard lives.
-/// Construct it BEFORE spawning and call started(pgid) after (not at all if the spawn failed): a
-/// handler that starts in between waits for it (up to 2 s). Several may live at once.
-class InterruptChild {
- public:
-  InterruptChild();
-  ~InterruptChild();
-  void started(pid_t pgid);
-  InterruptChild(const InterruptChild&) = delete;
-  InterruptChild& operator=(const InterruptChild&) = delete;
-
- private:
-  int slot_ = -1;
 };
 
 /// From install_interrupt_cleanup on, an exit() that main did not choose (a library ending the

@@ -1,32 +1,59 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
-// Publication-style PNG figures of measured histograms against analytic laws, drawn by gnuplot
-// (pngcairo). A figure is a value (laws/figure.hpp); writing it is one call.
+// Figures of a run: every figure is a value (figure.hpp; histograms against laws come from
+// laws/figure.hpp), drawn in-process by PLplot (cairo) as PNG and optionally SVG/PDF, with the
+// plotted data as CSV beside it. Files are created new (O_EXCL, never through a symlink) under a
+// temporary name in the directory given and renamed into place: never a partial file.
 #include <filesystem>
-#include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "asperity/app/figure.hpp"
 #include "asperity/laws/figure.hpp"
 
 namespace asperity {
 
-/// True if gnuplot with the pngcairo terminal is available.
+/// The image formats written per figure (CSV is always written).
+struct PlotFormats {
+  bool png = true, svg = false, pdf = false;
+};
+
+/// "png", "svg", "pdf", "png+svg", "png+pdf" (also "svg+pdf", "png+svg+pdf"). Throws
+/// std::invalid_argument naming the accepted values.
+PlotFormats parse_plot_formats(std::string_view text);
+std::string to_string(const PlotFormats& f);
+
+/// "" when figures can be drawn in `formats` (built with PLplot, its cairo driver installed), else
+/// why not, with what to install.
+std::string plotting_problem(const PlotFormats& formats = {});
+/// plotting_problem().empty().
 bool plotting_available();
 
-/// Writes `png` with two panels stacked vertically: linear y (top) and logarithmic y (bottom),
-/// like the paper's Figs. 3-5. Empty bins are omitted from the log panel. Writes to a temporary
-/// file and renames, so a failure never leaves a partial PNG. Throws std::runtime_error with
-/// gnuplot's message on failure.
+/// The two-panel figure of a histogram against its laws: linear y (top), logarithmic y (bottom,
+/// empty bins omitted), like the paper's Figs. 3-5. Throws std::invalid_argument for a figure that
+/// cannot be drawn (no bins, no counts, non-finite values, curves of unequal lengths).
+Figure histogram_figure(const HistogramFigure& fig);
+
+/// Measured points with their +-se error bars against predicted curves, one panel.
+Figure band_figure(const BandFigure& fig);
+
+/// Writes `fig` as dir/<stem>.png (and .svg / .pdf as `formats` says) and its data as
+/// dir/<stem>.csv; returns the file names written, images first. A failure removes what this
+/// call wrote and throws (std::invalid_argument for the figure, std::runtime_error for the files).
+std::vector<std::string> write_figure(const std::filesystem::path& dir, const std::string& stem, const Figure& fig,
+                                      const PlotFormats& formats = {});
+
+/// write_figure(png's directory, png's stem, histogram_figure(fig), png only).
 void write_histogram_png(const std::filesystem::path& png, const HistogramFigure& fig);
 
-/// Runs a caller-built gnuplot script that renders to the path it is given (a temporary beside
-/// `png`), then renames the result onto `png`: like write_histogram_png, a failure leaves no
-/// partial file. Throws std::runtime_error with gnuplot's message on failure.
-void write_gnuplot_png(const std::filesystem::path& png,
-                       const std::function<std::string(const std::filesystem::path& out)>& script);
+/// Each figure (its file "x.png" gives the stem "x") through write_figure, in order; returns every
+/// file written.
+std::vector<std::string> write_figures(const std::filesystem::path& dir, const std::vector<NamedFigure>& figures,
+                                       const PlotFormats& formats = {});
 
-/// Writes each figure to dir / file (write_histogram_png), in order; returns the file names.
-std::vector<std::string> write_figures(const std::filesystem::path& dir, const std::vector<NamedFigure>& figures);
+/// The figures among files a writer returned (report.json "plots"), and their data ("plot_data").
+std::vector<std::string> image_files(const std::vector<std::string>& files);
+std::vector<std::string> data_files(const std::vector<std::string>& files);
 
 }  // namespace asperity

@@ -75,7 +75,10 @@ struct Scene {
   /// report says so, legacy_mode_note); to_toml writes the name back. Empty otherwise.
   std::string legacy_mode;
   double alpha = 0.01;        ///< significance level of each test
-  bool plots = true;          ///< write PNG figures (needs gnuplot)
+  bool plots = true;          ///< write figures with their data as CSV (needs PLplot)
+  /// outputs.plot_format (--plot-format): png, svg, pdf, png+svg, png+pdf (app/plot.hpp
+  /// parse_plot_formats); the CSV is always written.
+  std::string plot_format = "png";
   bool contact_stats = true;  ///< analyse r_xy, r_x, r_y, r_z and core contacts against their laws
   /// Solve the impulse and analyse eps, Omega'_x when the experiment has impacts
   /// (ensemble.impact.enabled); off: the impact stage is skipped.
@@ -119,7 +122,7 @@ Scene preset(std::string_view name);
 
 /// Throws std::invalid_argument naming the offending field and value. Output names (report,
 /// export_ply) must be plain file names, distinct from each other, from the report's table
-/// (report_table_name) and from the figures (*.png).
+/// (report_table_name) and from the figures and their data (*.png, *.svg, *.pdf, *.csv).
 void validate(const Scene& s);
 
 /// The table's file name next to the report: its name with .txt ("report.json" -> "report.txt";

@@ -29,9 +29,6 @@ GeometryReport analyse_stream(const Scene& scene, const ContactStream& s);
 /// blocks of spheres) against the predicted F_exact - F_Eq14.
 BandFigure finite_n_figure(const Scene& scene, const ContactStream& s);
 
-/// Writes `fig` as a PNG (gnuplot; atomic like write_histogram_png).
-void write_band_png(const std::filesystem::path& png, const BandFigure& fig);
-
 /// run_scene's streaming branch (uses_streaming): the stream, its analysis, the finite-N figure
 /// (finite_n.png in `dir`, default s.out, when plots are planned) and the plan with stage times.
 /// `group` (rank 0 of a split run, s.share its share): the other processes' shares are gathered

@@ -215,7 +215,8 @@ struct MeshBounceReport {
 /// `base`: the mesh of e.mesh (read by the caller, app/mesh_io.hpp); null when e.mesh is empty
 /// (spheres). progress: (sequences done, total), between chunks of sequences.
 MeshBounceReport run_mesh_bounces(const MeshBounceExperiment& e, const TriangleMesh* base, const Progress& progress = {});
-/// "<body>, N = ..., ... sequences": the subtitle of a mesh-bounce run's figures.
+/// "<body>, N = ..., ... sequences": the subtitle of a mesh-bounce run's figures (figure markup, the
+/// body name escaped: laws/figure.hpp).
 std::string mesh_bounce_subtitle(const MeshBounceReport& r);
 
 }  // namespace asperity

@@ -1,14 +1,30 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // Figures as values: a measured histogram with the analytic laws to overlay. The layers below app/
-// build them; app/plot.hpp renders them (gnuplot), so no experiment writes a file.
+// build them; app/plot.hpp renders them (PLplot, in-process), so no experiment writes a file.
+//
+// Text (titles, labels, legends) is UTF-8 (Greek letters as themselves: ε, µ, λ) with a small
+// markup: `_{xy}` / `^{-6}` are sub/superscripts (`_x`, `^2` for one character), `\c` is the
+// character c itself. Text from a user (a mesh name) goes in through figure_text_literal, so that
+// it reads as written; whatever it contains, the renderer draws glyphs only.
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "asperity/laws/statistics.hpp"
 
 namespace asperity {
+
+/// `text` with the markup characters escaped: drawn exactly as written.
+inline std::string figure_text_literal(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (c == '\\' || c == '_' || c == '^' || c == '{' || c == '}') out += '\\';
+    out += c;
+  }
+  return out;
+}
 
 /// An analytic curve to overlay on a histogram.
 struct Curve {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "asperity/app/plan.hpp"
+#include "asperity/app/plot.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/config.hpp"
@@ -137,6 +138,7 @@ struct RawOptions {
   std::string preset_name = "fig3", asperities, radius, asperity_radius, drops, spheres, mode, backend, seed, out;
   std::string threads, alpha, statistics, bins_log2, checkpoint_every, resume;
   bool no_plots = false, quiet = false;
+  std::string plot_format;
   std::string scene_file;
   std::string speed, omega_x, omega_y;
   std::string variants, sequences;
@@ -178,7 +180,8 @@ void add_options(CLI::App& app, RawOptions& r) {
   app.add_option("--tangential", r.tangential,
                  "tangential law of the impacts: kinematic[:eps_t=E], coulomb:mu=M,restitution=newton|poisson|energetic, "
                  "stronge:mu=M, walton:mu=M,beta0=B (sphere impacts, the explicit bounce variants, mesh bodies)");
-  app.add_flag("--no-plots", r.no_plots, "do not write PNG figures");
+  app.add_flag("--no-plots", r.no_plots, "do not write figures (nor their data, CSV)");
+  app.add_option("--plot-format", r.plot_format, "figures as png (default), svg, pdf, png+svg or png+pdf; CSV always");
   app.add_flag("--quiet,-q", r.quiet, "print no progress");
 }
 
@@ -511,6 +514,14 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
     scene.alpha = a;
   }
   if (r.no_plots) scene.plots = false;
+  if (given("--plot-format")) {
+    try {
+      parse_plot_formats(r.plot_format);
+    } catch (const std::invalid_argument& ex) {
+      throw BadInput(std::string("--plot-format: ") + ex.what());
+    }
+    scene.plot_format = r.plot_format;
+  }
   if (given("--out")) {
     if (r.out.empty()) throw BadInput("--out: '' is not a directory name");
     scene.out = r.out;

@@ -68,8 +68,9 @@ std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& 
     scene = o.scene;
     scene.share = share.ranks > 1 && streams(scene) ? share : StreamShare{};
     quiet = o.quiet || share.rank > 0;
-    if (scene.plots && share.rank == 0 && !plotting_available())  // only rank 0 draws
-      throw BadInput("gnuplot with the pngcairo terminal is needed for figures (run scripts/setup), or pass --no-plots");
+    if (scene.plots && share.rank == 0)  // only rank 0 draws
+      if (const std::string why = plotting_problem(parse_plot_formats(scene.plot_format)); !why.empty())
+        throw BadInput("figures cannot be drawn: " + why + "; or pass --no-plots");
     check_scene_inputs(scene);
     check_memory(scene);
   } catch (const std::exception& ex) {
@@ -199,7 +200,7 @@ namespace {
 
 int run_main(int argc, char** argv) {
   // First, before any thread exists: SIGINT/SIGTERM/SIGHUP/SIGPIPE remove this run's temporaries
-  // (its staging directory, gnuplot's files, the directories it created) and exit 128 + signal.
+  // (its staging directory, its temporary files, the directories it created) and exit 128 + signal.
   install_interrupt_cleanup("validate-geometry");
   // Explicit runs build and drop K spheres and indexes of a few MB each: keep freed memory in the
   // heap instead of returning it to the kernel, so that the next sphere does not page-fault its

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+#pragma once
+// The one place that draws (PLplot, through cairo): a Figure in, the bytes of the file out. No
+// path ever reaches PLplot (it writes into memory), and no text reaches it unconverted: the
+// figure markup becomes PLplot's sub/superscript escapes, '#' becomes "##", so a label can change
+// nothing but the glyphs drawn.
+#include <string>
+#include <string_view>
+
+#include "asperity/app/figure.hpp"
+
+namespace asperity::detail {
+
+enum class ImageFormat { png, svg, pdf };
+
+/// "" when `format` can be drawn (built with PLplot, its cairo driver found), else why not.
+std::string renderer_problem(ImageFormat format);
+
+/// The file `fig` draws to in `format`. Throws std::invalid_argument for a figure that cannot be
+/// drawn (no panels, lengths that differ, non-finite values), std::runtime_error when PLplot
+/// reports an error. Serialised: PLplot's state is global.
+std::string render_figure(const Figure& fig, ImageFormat format);
+
+/// The figure markup as PLplot text: `_{..}` / `^{..}` (or `_c` / `^c`) as sub/superscripts,
+/// `\c` as c, '#' as "##", control characters and invalid UTF-8 as '?'.
+std::string plplot_text(std::string_view markup);
+
+/// The figure markup as plain text (CSV headers): markup characters kept as written, braces of
+/// sub/superscripts dropped ("r_{xy}" -> "r_xy"), escapes resolved.
+std::string plain_text(std::string_view markup);
+
+}  // namespace asperity::detail
