@@ -68,7 +68,7 @@ namespace asperity {
 /// one panel.
 struct BandFigure {
   ///@{
-  /// Title and axis labels (gnuplot enhanced text; labels with units, e.g. "r_{xy} [{/Symbol m}m]").
+  /// Title and axis labels (the figure markup of app/figure.hpp: _{..}, ^{..}; labels with units, e.g. "r_{xy} [µm]").
   std::string title, xlabel, ylabel;
   ///@}
   std::string data_label;   ///< the ensemble the points come from, with n
