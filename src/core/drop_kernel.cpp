@@ -1,0 +1,209 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// The CPU instantiations of the drop kernel (drop_kernel.hpp): the scalar reference, one drop at a
+// time, and SIMD, kW drops per vector with GCC vector types in functions cloned for avx512f, avx2
+// and the default target (resolved once, by ifunc). Both call the same inline functions; vector
+// lanes perform the same IEEE operations in the same order as the scalar code, so the bits agree.
+// Rejected disk attempts (~21 % per disk) are finished lane by lane by the scalar code.
+#include "asperity/core/drop_kernel.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define ASPERITY_DROP_SIMD 1
+#define ASPERITY_DROP_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define ASPERITY_DROP_SIMD 0  // other compilers: simd runs the scalar reference (the same bits)
+#endif
+
+namespace asperity {
+
+std::string_view to_string(Kernel k) {
+  switch (k) {
+    case Kernel::scalar: return "scalar";
+    case Kernel::simd: return "simd";
+    case Kernel::gpu: return "gpu";
+  }
+  return "?";
+}
+
+Kernel parse_kernel(std::string_view name) {
+  for (Kernel k : {Kernel::scalar, Kernel::simd, Kernel::gpu})
+    if (name == to_string(k)) return k;
+  throw std::invalid_argument("unknown kernel \"" + std::string(name) + "\" (scalar, simd, gpu)");
+}
+
+bool kernel_available(Kernel k) { return k != Kernel::gpu; }  // the CUDA backend is not wired yet
+
+namespace {
+
+using kernel::ScalarSqrt;
+
+double gap_of(double k1, double k2, double R) {
+  return std::isfinite(k2) ? 0.5 * R * (k2 - k1) : std::numeric_limits<double>::infinity();
+}
+
+// The scalar reference: never auto-vectorised, so that it is what a one-lane machine would do.
+__attribute__((optimize("no-tree-vectorize"))) void draw_scalar(std::uint64_t seed, std::uint64_t first,
+                                                                 std::span<Vec3> d, std::span<double> c,
+                                                                 std::span<double> s) {
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    double x, y, z;
+    kernel::draw_one(seed, first + i, x, y, z, c[i], s[i]);
+    d[i] = Vec3(x, y, z);
+  }
+}
+
+__attribute__((optimize("no-tree-vectorize"))) void contacts_scalar(std::span<const Vec3> d, std::span<const double> c,
+                                                                     std::span<const double> s,
+                                                                     std::span<const Nearest> nn,
+                                                                     std::span<const Vec3> centres, double R, double a,
+                                                                     std::span<Contact> out) {
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const Vec3& u = centres[nn[i].index];
+    Contact& o = out[i];
+    double rx, ry, rz;
+    kernel::contact_quantities(d[i].x(), d[i].y(), d[i].z(), c[i], s[i], u.x(), u.y(), u.z(), nn[i].key, R, a, o.r_xy,
+                               rx, ry, rz, ScalarSqrt{});
+    o.index = nn[i].index;
+    o.r = Vec3(rx, ry, rz);
+    o.gap = gap_of(nn[i].key, nn[i].runner_up_key, R);
+    o.core = core_touches_first(nn[i].key, R, a);
+  }
+}
+
+#if ASPERITY_DROP_SIMD
+#pragma GCC diagnostic ignored "-Wpsabi"  // vector types never cross a non-inline boundary
+constexpr std::size_t kW = 8;             // drops per vector (iota below)
+using u32v = std::uint32_t __attribute__((vector_size(4 * kW)));
+using i32v = std::int32_t __attribute__((vector_size(4 * kW)));
+using u64v = std::uint64_t __attribute__((vector_size(8 * kW)));
+using f64v = double __attribute__((vector_size(8 * kW)));
+
+struct VectorLanes {
+  [[gnu::always_inline]] u64v operator()(u32v x) const { return __builtin_convertvector(x, u64v); }
+  [[gnu::always_inline]] u32v operator()(u64v x) const { return __builtin_convertvector(x, u32v); }
+  [[gnu::always_inline]] f64v operator()(i32v x) const { return __builtin_convertvector(x, f64v); }
+};
+struct VectorSqrt {
+  // Lane by lane; with -fno-math-errno (this file) GCC emits the vector sqrt (IEEE, correctly rounded).
+  [[gnu::always_inline]] f64v operator()(f64v x) const {
+    f64v r;
+    for (std::size_t l = 0; l < kW; ++l) r[l] = __builtin_sqrt(x[l]);
+    return r;
+  }
+};
+
+struct Disk {
+  f64v x, y, s;
+};
+
+// First attempts of disk w for drops first .. first + kW - 1, rejected lanes finished by the scalar code.
+[[gnu::always_inline]] inline Disk disk_lanes(std::uint64_t seed, std::uint64_t first, std::uint32_t w) {
+  // Counter (index lo, index hi, w, purpose) of drops first + l: the low words with their carry.
+  const u32v zero = {}, iota = {0, 1, 2, 3, 4, 5, 6, 7};
+  const auto lo0 = static_cast<std::uint32_t>(first);
+  const u32v lo = zero + lo0 + iota;
+  const u32v wrapped = reinterpret_cast<u32v>(lo < lo0);  // all ones where the low word wrapped
+  u32v c[4] = {lo, zero + static_cast<std::uint32_t>(first >> 32) - wrapped, zero + w, zero + kernel::kPurposeDrop};
+  const VectorLanes L;
+  kernel::philox4x32_10(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L, L);
+  const u32v flip = c[1] ^ 0x80000000u, flip3 = c[3] ^ 0x80000000u;
+  Disk k;
+  k.x = kernel::coordinate<f64v>(reinterpret_cast<i32v>(c[0]), reinterpret_cast<i32v>(flip), L);
+  k.y = kernel::coordinate<f64v>(reinterpret_cast<i32v>(c[2]), reinterpret_cast<i32v>(flip3), L);
+  k.s = k.x * k.x + k.y * k.y;
+  const auto ok = (k.s < 1.0) & (k.s > 0.0);
+  for (std::size_t l = 0; l < kW; ++l)
+    if (!ok[l]) {
+      double x, y, s;
+      kernel::disk_from(seed, first + l, w, 1, x, y, s);
+      k.x[l] = x, k.y[l] = y, k.s[l] = s;
+    }
+  return k;
+}
+
+ASPERITY_DROP_CLONES
+void draw_simd(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
+  const std::size_t n = d.size();
+  for (std::size_t i = 0; i < n; i += kW) {
+    // A tail shorter than kW computes whole vectors and stores its lanes only.
+    const Disk p = disk_lanes(seed, first + i, 0), q = disk_lanes(seed, first + i, 1);
+    f64v dx, dy, dz, cc, sn;
+    kernel::sphere_point(p.x, p.y, p.s, dx, dy, dz, VectorSqrt{});
+    kernel::azimuth(q.x, q.y, q.s, cc, sn, VectorSqrt{});
+    for (std::size_t l = 0; l < kW && i + l < n; ++l) {
+      d[i + l] = Vec3(dx[l], dy[l], dz[l]);
+      c[i + l] = cc[l], s[i + l] = sn[l];
+    }
+  }
+}
+
+ASPERITY_DROP_CLONES
+void contacts_simd(std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
+                   std::span<const Nearest> nn, std::span<const Vec3> centres, double R, double a,
+                   std::span<Contact> out) {
+  const std::size_t n = d.size();
+  for (std::size_t i = 0; i < n; i += kW) {
+    f64v dx{}, dy{}, dz{}, cc{}, sn{}, ux{}, uy{}, uz{}, k{};
+    for (std::size_t l = 0; l < kW && i + l < n; ++l) {
+      const Vec3& u = centres[nn[i + l].index];
+      dx[l] = d[i + l].x(), dy[l] = d[i + l].y(), dz[l] = d[i + l].z();
+      cc[l] = c[i + l], sn[l] = s[i + l];
+      ux[l] = u.x(), uy[l] = u.y(), uz[l] = u.z(), k[l] = nn[i + l].key;
+    }
+    f64v rxy, rx, ry, rz;
+    kernel::contact_quantities(dx, dy, dz, cc, sn, ux, uy, uz, k, R, a, rxy, rx, ry, rz, VectorSqrt{});
+    for (std::size_t l = 0; l < kW && i + l < n; ++l) {
+      const Nearest& r = nn[i + l];
+      Contact& o = out[i + l];
+      o.index = r.index;
+      o.r = Vec3(rx[l], ry[l], rz[l]);
+      o.r_xy = rxy[l];
+      o.gap = gap_of(r.key, r.runner_up_key, R);
+      o.core = core_touches_first(r.key, R, a);
+    }
+  }
+}
+#endif  // ASPERITY_DROP_SIMD
+
+void check_sizes(std::size_t n, std::size_t a, std::size_t b, const char* what) {
+  if (a != n || b != n) throw std::invalid_argument(std::string(what) + ": spans of different sizes");
+}
+
+}  // namespace
+
+void draw_drops(Kernel k, std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c,
+                std::span<double> s) {
+  check_sizes(d.size(), c.size(), s.size(), "draw_drops");
+  if (k == Kernel::gpu) throw std::invalid_argument("draw_drops: the gpu kernel runs on the device (drop_kernel.cu)");
+#if ASPERITY_DROP_SIMD
+  if (k == Kernel::simd) return draw_simd(seed, first, d, c, s);
+#endif
+  draw_scalar(seed, first, d, c, s);
+}
+
+DropDraw draw_drop(std::uint64_t seed, std::uint64_t index) {
+  DropDraw r;
+  double x, y, z;
+  kernel::draw_one(seed, index, x, y, z, r.c, r.s);
+  r.d = Vec3(x, y, z);
+  return r;
+}
+
+void drop_contacts(Kernel k, std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
+                   std::span<const Nearest> nn, std::span<const Vec3> centres, double R, double a,
+                   std::span<Contact> out) {
+  check_sizes(d.size(), c.size(), s.size(), "drop_contacts");
+  check_sizes(d.size(), nn.size(), out.size(), "drop_contacts");
+  if (k == Kernel::gpu) throw std::invalid_argument("drop_contacts: the gpu kernel runs on the device (drop_kernel.cu)");
+#if ASPERITY_DROP_SIMD
+  if (k == Kernel::simd) return contacts_simd(d, c, s, nn, centres, R, a, out);
+#endif
+  contacts_scalar(d, c, s, nn, centres, R, a, out);
+}
+
+}  // namespace asperity
