@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The CPU instantiations of the drop kernel (drop_kernel.hpp): the scalar reference, one drop at a
-// time, and SIMD, kW drops per vector with GCC vector types in functions cloned for avx512f, avx2
-// and the default target (resolved once, by ifunc). Both call the same inline functions; vector
+// time, and SIMD, kW drops per vector with GCC vector types, one body compiled for avx512f, avx2
+// and SSE2 (the x86-64 baseline), chosen once from the CPU (detail::best_isa). Both call the same inline functions; vector
 // lanes perform the same IEEE operations in the same order as the scalar code, so the bits agree.
 // Rejected disk attempts (~21 % per disk) are finished lane by lane by the scalar code.
 #include "asperity/core/drop_kernel.hpp"
+
+#include "core/drop_kernel_detail.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -12,9 +14,8 @@
 #include <stdexcept>
 #include <string>
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define ASPERITY_DROP_SIMD 1
-#define ASPERITY_DROP_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define ASPERITY_DROP_SIMD 0  // other compilers: simd runs the scalar reference (the same bits)
 #endif
@@ -126,8 +127,7 @@ struct Disk {
   return k;
 }
 
-ASPERITY_DROP_CLONES
-void draw_simd(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
+[[gnu::always_inline]] inline void draw_simd(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
   const std::size_t n = d.size();
   for (std::size_t i = 0; i < n; i += kW) {
     // A tail shorter than kW computes whole vectors and stores its lanes only.
@@ -142,8 +142,7 @@ void draw_simd(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::
   }
 }
 
-ASPERITY_DROP_CLONES
-void contacts_simd(std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
+[[gnu::always_inline]] inline void contacts_simd(std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
                    std::span<const Nearest> nn, std::span<const Vec3> centres, double R, double a,
                    std::span<Contact> out) {
   const std::size_t n = d.size();
@@ -168,6 +167,36 @@ void contacts_simd(std::span<const Vec3> d, std::span<const double> c, std::span
     }
   }
 }
+// The clones (function multi-versioning by hand, so that tests can run each one): the same body
+// compiled for each target; the default one is SSE2, which every x86-64 has.
+__attribute__((target("avx512f"))) void draw_avx512(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
+                                                     std::span<double> c, std::span<double> s) {
+  draw_simd(seed, first, d, c, s);
+}
+__attribute__((target("avx2"))) void draw_avx2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
+                                               std::span<double> c, std::span<double> s) {
+  draw_simd(seed, first, d, c, s);
+}
+void draw_sse2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
+  draw_simd(seed, first, d, c, s);
+}
+__attribute__((target("avx512f"))) void contacts_avx512(std::span<const Vec3> d, std::span<const double> c,
+                                                        std::span<const double> s, std::span<const Nearest> nn,
+                                                        std::span<const Vec3> centres, double R, double a,
+                                                        std::span<Contact> out) {
+  contacts_simd(d, c, s, nn, centres, R, a, out);
+}
+__attribute__((target("avx2"))) void contacts_avx2(std::span<const Vec3> d, std::span<const double> c,
+                                                   std::span<const double> s, std::span<const Nearest> nn,
+                                                   std::span<const Vec3> centres, double R, double a,
+                                                   std::span<Contact> out) {
+  contacts_simd(d, c, s, nn, centres, R, a, out);
+}
+void contacts_sse2(std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
+                   std::span<const Nearest> nn, std::span<const Vec3> centres, double R, double a,
+                   std::span<Contact> out) {
+  contacts_simd(d, c, s, nn, centres, R, a, out);
+}
 #endif  // ASPERITY_DROP_SIMD
 
 void check_sizes(std::size_t n, std::size_t a, std::size_t b, const char* what) {
@@ -180,9 +209,7 @@ void draw_drops(Kernel k, std::uint64_t seed, std::uint64_t first, std::span<Vec
                 std::span<double> s) {
   check_sizes(d.size(), c.size(), s.size(), "draw_drops");
   if (k == Kernel::gpu) throw std::invalid_argument("draw_drops: the gpu kernel runs on the device (drop_kernel.cu)");
-#if ASPERITY_DROP_SIMD
-  if (k == Kernel::simd) return draw_simd(seed, first, d, c, s);
-#endif
+  if (k == Kernel::simd) return detail::draw_drops_isa(detail::best_isa(), seed, first, d, c, s);
   draw_scalar(seed, first, d, c, s);
 }
 
@@ -200,10 +227,66 @@ void drop_contacts(Kernel k, std::span<const Vec3> d, std::span<const double> c,
   check_sizes(d.size(), c.size(), s.size(), "drop_contacts");
   check_sizes(d.size(), nn.size(), out.size(), "drop_contacts");
   if (k == Kernel::gpu) throw std::invalid_argument("drop_contacts: the gpu kernel runs on the device (drop_kernel.cu)");
-#if ASPERITY_DROP_SIMD
-  if (k == Kernel::simd) return contacts_simd(d, c, s, nn, centres, R, a, out);
-#endif
+  if (k == Kernel::simd) return detail::drop_contacts_isa(detail::best_isa(), d, c, s, nn, centres, R, a, out);
   contacts_scalar(d, c, s, nn, centres, R, a, out);
 }
+
+namespace detail {
+
+bool isa_available(SimdIsa isa) {
+#if ASPERITY_DROP_SIMD
+  switch (isa) {
+    case SimdIsa::avx512f: return __builtin_cpu_supports("avx512f");
+    case SimdIsa::avx2: return __builtin_cpu_supports("avx2");
+    case SimdIsa::sse2: return true;
+    case SimdIsa::none: return true;
+  }
+  return false;
+#else
+  return isa == SimdIsa::none;
+#endif
+}
+
+SimdIsa best_isa() {
+  // Resolved once (the CPU does not change under a running process).
+  static const SimdIsa best = [] {
+    for (SimdIsa i : {SimdIsa::avx512f, SimdIsa::avx2, SimdIsa::sse2})
+      if (isa_available(i)) return i;
+    return SimdIsa::none;
+  }();
+  return best;
+}
+
+void draw_drops_isa(SimdIsa isa, std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c,
+                    std::span<double> s) {
+  check_sizes(d.size(), c.size(), s.size(), "draw_drops");
+  if (!isa_available(isa)) throw std::invalid_argument("draw_drops: this CPU lacks the instruction set asked for");
+  switch (isa) {
+#if ASPERITY_DROP_SIMD
+    case SimdIsa::avx512f: return draw_avx512(seed, first, d, c, s);
+    case SimdIsa::avx2: return draw_avx2(seed, first, d, c, s);
+    case SimdIsa::sse2: return draw_sse2(seed, first, d, c, s);
+#endif
+    default: return draw_scalar(seed, first, d, c, s);
+  }
+}
+
+void drop_contacts_isa(SimdIsa isa, std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
+                       std::span<const Nearest> nn, std::span<const Vec3> centres, double R, double a,
+                       std::span<Contact> out) {
+  check_sizes(d.size(), c.size(), s.size(), "drop_contacts");
+  check_sizes(d.size(), nn.size(), out.size(), "drop_contacts");
+  if (!isa_available(isa)) throw std::invalid_argument("drop_contacts: this CPU lacks the instruction set asked for");
+  switch (isa) {
+#if ASPERITY_DROP_SIMD
+    case SimdIsa::avx512f: return contacts_avx512(d, c, s, nn, centres, R, a, out);
+    case SimdIsa::avx2: return contacts_avx2(d, c, s, nn, centres, R, a, out);
+    case SimdIsa::sse2: return contacts_sse2(d, c, s, nn, centres, R, a, out);
+#endif
+    default: return contacts_scalar(d, c, s, nn, centres, R, a, out);
+  }
+}
+
+}  // namespace detail
 
 }  // namespace asperity

@@ -18,10 +18,21 @@
 #include "asperity/core/drop_kernel.hpp"
 #include "asperity/core/geometry.hpp"
 #include "asperity/laws/statistics.hpp"
+#include "core/drop_kernel_detail.hpp"
 
 using namespace asperity;
 
 namespace {
+
+using detail::SimdIsa;
+
+// Every SIMD variant this CPU runs (the scalar reference is the oracle, not in the list).
+std::vector<SimdIsa> variants() {
+  std::vector<SimdIsa> v;
+  for (SimdIsa i : {SimdIsa::sse2, SimdIsa::avx2, SimdIsa::avx512f})
+    if (detail::isa_available(i)) v.push_back(i);
+  return v;
+}
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 bool same_bits(const Vec3& a, const Vec3& b) {
@@ -39,6 +50,11 @@ Draws draw(Kernel k, std::uint64_t seed, std::uint64_t first, std::size_t n) {
   draw_drops(k, seed, first, r.d, r.c, r.s);
   return r;
 }
+Draws draw(SimdIsa isa, std::uint64_t seed, std::uint64_t first, std::size_t n) {
+  Draws r(n);
+  detail::draw_drops_isa(isa, seed, first, r.d, r.c, r.s);
+  return r;
+}
 
 void expect_same_draws(const Draws& a, const Draws& b) {
   ASSERT_EQ(a.d.size(), b.d.size());
@@ -52,10 +68,24 @@ std::vector<Vec3> sphere(std::uint64_t n, std::uint64_t seed) {
   return make_rough_sphere(SphereParams{n, 3e-3, 6.5e-7}, seed, 0).centres;
 }
 
-std::vector<Contact> contacts(Kernel k, const Draws& w, std::span<const Nearest> nn, std::span<const Vec3> centres) {
+std::vector<Contact> contacts(SimdIsa isa, const Draws& w, std::span<const Nearest> nn, std::span<const Vec3> centres) {
   std::vector<Contact> out(w.d.size());
-  drop_contacts(k, w.d, w.c, w.s, nn, centres, 3e-3, 6.5e-7, out);
+  detail::drop_contacts_isa(isa, w.d, w.c, w.s, nn, centres, 3e-3, 6.5e-7, out);
   return out;
+}
+
+void expect_same_contacts(const std::vector<Contact>& a, const std::vector<Contact>& b);
+
+// Every variant's contacts equal the scalar reference's, and Kernel::simd is one of them.
+void expect_variants_agree(const Draws& w, std::span<const Nearest> nn, std::span<const Vec3> centres) {
+  const auto ref = contacts(SimdIsa::none, w, nn, centres);
+  for (SimdIsa isa : variants()) {
+    SCOPED_TRACE(testing::Message() << "isa " << int(isa));
+    expect_same_contacts(contacts(isa, w, nn, centres), ref);
+  }
+  std::vector<Contact> simd(w.d.size());
+  drop_contacts(Kernel::simd, w.d, w.c, w.s, nn, centres, 3e-3, 6.5e-7, simd);
+  expect_same_contacts(simd, ref);
 }
 
 void expect_same_contacts(const std::vector<Contact>& a, const std::vector<Contact>& b) {
@@ -113,7 +143,12 @@ TEST(DropKernel, SimdDrawsEqualScalarBitForBit) {
     for (std::uint64_t first : {std::uint64_t{0}, std::uint64_t{(1ull << 32) - 3}, std::uint64_t{123456789012345}})
       for (std::size_t n : {1, 7, 8, 9, 15, 256, 1001}) {
         SCOPED_TRACE(testing::Message() << "seed " << seed << " first " << first << " n " << n);
-        expect_same_draws(draw(Kernel::simd, seed, first, n), draw(Kernel::scalar, seed, first, n));
+        const Draws ref = draw(Kernel::scalar, seed, first, n);
+        expect_same_draws(draw(Kernel::simd, seed, first, n), ref);
+        for (SimdIsa isa : variants()) {
+          SCOPED_TRACE(testing::Message() << "isa " << int(isa));
+          expect_same_draws(draw(isa, seed, first, n), ref);
+        }
       }
 }
 
@@ -125,7 +160,7 @@ TEST(DropKernel, WholeDropsAnswerAsBruteForceAndSimdEqualsScalar) {
     std::vector<Nearest> nn(w.d.size());
     grid->lowest(w.d, nn);
     for (std::size_t i = 0; i < nn.size(); ++i) ASSERT_EQ(nn[i], brute_lowest(centres, w.d[i])) << N << " " << i;
-    expect_same_contacts(contacts(Kernel::simd, w, nn, centres), contacts(Kernel::scalar, w, nn, centres));
+    expect_variants_agree(w, nn, centres);
   }
 }
 
@@ -143,7 +178,7 @@ TEST(DropKernel, AdversarialDirectionsGiveTheSameContacts) {
   const auto grid = make_contact_query(Backend::grid, centres);
   grid->lowest(w.d, nn);
   for (std::size_t i = 0; i < nn.size(); ++i) ASSERT_EQ(nn[i], brute_lowest(centres, d[i])) << i;
-  expect_same_contacts(contacts(Kernel::simd, w, nn, centres), contacts(Kernel::scalar, w, nn, centres));
+  expect_variants_agree(w, nn, centres);
 }
 
 // n = 2e5 drops. Direction: Pearson chi-square over 100 equal-area cells (99 dof); azimuth: 64
@@ -174,4 +209,5 @@ TEST(DropKernel, ParsesKernelNames) {
   for (Kernel k : {Kernel::scalar, Kernel::simd, Kernel::gpu}) EXPECT_EQ(parse_kernel(to_string(k)), k);
   EXPECT_THROW(parse_kernel("avx"), std::invalid_argument);
   EXPECT_TRUE(kernel_available(Kernel::scalar) && kernel_available(Kernel::simd));
+  std::printf("SIMD variants run here: %zu (best %d)\n", variants().size(), int(detail::best_isa()));
 }
