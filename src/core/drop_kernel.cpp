@@ -81,16 +81,23 @@ __attribute__((optimize("no-tree-vectorize"))) void contacts_scalar(std::span<co
 constexpr std::size_t kW = 8;             // drops per vector (iota below)
 using u32v = std::uint32_t __attribute__((vector_size(4 * kW)));
 using i32v = std::int32_t __attribute__((vector_size(4 * kW)));
-using u64v = std::uint64_t __attribute__((vector_size(8 * kW)));
 using f64v = double __attribute__((vector_size(8 * kW)));
 
 struct VectorLanes {
-  [[gnu::always_inline]] u64v operator()(u32v x) const { return __builtin_convertvector(x, u64v); }
-  [[gnu::always_inline]] u32v operator()(u64v x) const { return __builtin_convertvector(x, u32v); }
+  // Lane by lane, so that GCC sees the widening multiply (vpmuludq on the even and odd lanes)
+  // rather than a full 64 x 64-bit product of widened vectors.
+  [[gnu::always_inline]] void operator()(u32v a, std::uint32_t m, u32v& hi, u32v& lo) const {
+    for (std::size_t l = 0; l < kW; ++l) {
+      const std::uint64_t p = static_cast<std::uint64_t>(a[l]) * m;
+      hi[l] = static_cast<std::uint32_t>(p >> 32), lo[l] = static_cast<std::uint32_t>(p);
+    }
+  }
   [[gnu::always_inline]] f64v operator()(i32v x) const { return __builtin_convertvector(x, f64v); }
 };
 struct VectorSqrt {
-  // Lane by lane; with -fno-math-errno (this file) GCC emits the vector sqrt (IEEE, correctly rounded).
+  // Lane by lane; GCC emits the vector sqrt (IEEE, correctly rounded) given -fno-math-errno and
+  // -fno-rounding-math (this file: CGAL's -frounding-math would keep it scalar; the kernel runs in
+  // the default rounding mode only).
   [[gnu::always_inline]] f64v operator()(f64v x) const {
     f64v r;
     for (std::size_t l = 0; l < kW; ++l) r[l] = __builtin_sqrt(x[l]);
@@ -111,7 +118,7 @@ struct Disk {
   const u32v wrapped = reinterpret_cast<u32v>(lo < lo0);  // all ones where the low word wrapped
   u32v c[4] = {lo, zero + static_cast<std::uint32_t>(first >> 32) - wrapped, zero + w, zero + kernel::kPurposeDrop};
   const VectorLanes L;
-  kernel::philox4x32_10(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L, L);
+  kernel::philox4x32_10(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L);
   const u32v flip = c[1] ^ 0x80000000u, flip3 = c[3] ^ 0x80000000u;
   Disk k;
   k.x = kernel::coordinate<f64v>(reinterpret_cast<i32v>(c[0]), reinterpret_cast<i32v>(flip), L);
@@ -127,14 +134,15 @@ struct Disk {
   return k;
 }
 
+template <class Sqrt>
 [[gnu::always_inline]] inline void draw_simd(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
   const std::size_t n = d.size();
   for (std::size_t i = 0; i < n; i += kW) {
     // A tail shorter than kW computes whole vectors and stores its lanes only.
     const Disk p = disk_lanes(seed, first + i, 0), q = disk_lanes(seed, first + i, 1);
     f64v dx, dy, dz, cc, sn;
-    kernel::sphere_point(p.x, p.y, p.s, dx, dy, dz, VectorSqrt{});
-    kernel::azimuth(q.x, q.y, q.s, cc, sn, VectorSqrt{});
+    kernel::sphere_point(p.x, p.y, p.s, dx, dy, dz, Sqrt{});
+    kernel::azimuth(q.x, q.y, q.s, cc, sn, Sqrt{});
     for (std::size_t l = 0; l < kW && i + l < n; ++l) {
       d[i + l] = Vec3(dx[l], dy[l], dz[l]);
       c[i + l] = cc[l], s[i + l] = sn[l];
@@ -142,6 +150,7 @@ struct Disk {
   }
 }
 
+template <class Sqrt>
 [[gnu::always_inline]] inline void contacts_simd(std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
                    std::span<const Nearest> nn, std::span<const Vec3> centres, double R, double a,
                    std::span<Contact> out) {
@@ -155,7 +164,7 @@ struct Disk {
       ux[l] = u.x(), uy[l] = u.y(), uz[l] = u.z(), k[l] = nn[i + l].key;
     }
     f64v rxy, rx, ry, rz;
-    kernel::contact_quantities(dx, dy, dz, cc, sn, ux, uy, uz, k, R, a, rxy, rx, ry, rz, VectorSqrt{});
+    kernel::contact_quantities(dx, dy, dz, cc, sn, ux, uy, uz, k, R, a, rxy, rx, ry, rz, Sqrt{});
     for (std::size_t l = 0; l < kW && i + l < n; ++l) {
       const Nearest& r = nn[i + l];
       Contact& o = out[i + l];
@@ -171,31 +180,31 @@ struct Disk {
 // compiled for each target; the default one is SSE2, which every x86-64 has.
 __attribute__((target("avx512f"))) void draw_avx512(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
                                                      std::span<double> c, std::span<double> s) {
-  draw_simd(seed, first, d, c, s);
+  draw_simd<VectorSqrt>(seed, first, d, c, s);
 }
 __attribute__((target("avx2"))) void draw_avx2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
                                                std::span<double> c, std::span<double> s) {
-  draw_simd(seed, first, d, c, s);
+  draw_simd<VectorSqrt>(seed, first, d, c, s);
 }
 void draw_sse2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
-  draw_simd(seed, first, d, c, s);
+  draw_simd<VectorSqrt>(seed, first, d, c, s);
 }
 __attribute__((target("avx512f"))) void contacts_avx512(std::span<const Vec3> d, std::span<const double> c,
                                                         std::span<const double> s, std::span<const Nearest> nn,
                                                         std::span<const Vec3> centres, double R, double a,
                                                         std::span<Contact> out) {
-  contacts_simd(d, c, s, nn, centres, R, a, out);
+  contacts_simd<VectorSqrt>(d, c, s, nn, centres, R, a, out);
 }
 __attribute__((target("avx2"))) void contacts_avx2(std::span<const Vec3> d, std::span<const double> c,
                                                    std::span<const double> s, std::span<const Nearest> nn,
                                                    std::span<const Vec3> centres, double R, double a,
                                                    std::span<Contact> out) {
-  contacts_simd(d, c, s, nn, centres, R, a, out);
+  contacts_simd<VectorSqrt>(d, c, s, nn, centres, R, a, out);
 }
 void contacts_sse2(std::span<const Vec3> d, std::span<const double> c, std::span<const double> s,
                    std::span<const Nearest> nn, std::span<const Vec3> centres, double R, double a,
                    std::span<Contact> out) {
-  contacts_simd(d, c, s, nn, centres, R, a, out);
+  contacts_simd<VectorSqrt>(d, c, s, nn, centres, R, a, out);
 }
 #endif  // ASPERITY_DROP_SIMD
 

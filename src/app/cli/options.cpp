@@ -138,6 +138,7 @@ struct RawOptions {
   std::string speed, omega_x, omega_y;
   std::string variants, sequences;
   std::string tangential;
+  std::string kernel;
 };
 
 void add_options(CLI::App& app, RawOptions& r) {
@@ -155,6 +156,7 @@ void add_options(CLI::App& app, RawOptions& r) {
   app.add_option("--seed", r.seed, "random seed (results are identical for any thread count)");
   app.add_option("--backend", r.backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
   app.add_option("--threads", r.threads, "OpenMP threads (0 = all)");
+  app.add_option("--kernel", r.kernel, "drop kernel of the explicit drops: simd (default) or scalar (the reference; the same bits)");
   app.add_option("--statistics", r.statistics,
                  "auto (default: streaming above 2^25 drops without impacts), raw (every drop kept: exact KS, figures "
                  "of every quantity) or streaming (integer histograms, memory independent of the drops; contact only)");
@@ -162,8 +164,8 @@ void add_options(CLI::App& app, RawOptions& r) {
   app.add_option("--checkpoint-every", r.checkpoint_every,
                  "streaming: seconds between checkpoints in --out (default 300; 0: only on SIGINT/SIGTERM)");
   app.add_option("--resume", r.resume,
-                 "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only --threads, --quiet, "
-                 "--no-plots, --checkpoint-every may be given)")
+                 "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only --threads, --kernel, "
+                 "--quiet, --no-plots, --checkpoint-every may be given)")
       ->excludes(preset_opt);
   app.add_option("--alpha", r.alpha, "significance level of each test, in (0,1)");
   app.add_option("--out", r.out, "output directory for report.json and figures");
@@ -451,8 +453,8 @@ void check_resume_option(const RawOptions& r, const Given& given) {
                         "--seed", "--backend", "--alpha", "--out", "--speed", "--omega-x", "--omega-y", "--variant",
                         "--sequences", "--statistics", "--bins-log2", "--tangential"})
     if (given(o))
-      throw BadInput(std::string(o) + ": --resume continues the checkpoint's own scene; only --threads, --quiet, "
-                                      "--no-plots and --checkpoint-every may be given with it");
+      throw BadInput(std::string(o) + ": --resume continues the checkpoint's own scene; only --threads, --kernel, "
+                                      "--quiet, --no-plots and --checkpoint-every may be given with it");
   if (r.resume.empty()) throw BadInput("--resume: '' is not a directory name");
 }
 
@@ -470,6 +472,8 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
                      "decide nothing (exit status 0)");
     scene.alpha = a;
   }
+  // The drop kernel changes no bit (so it may come with --resume); validate() refuses one not built.
+  if (given("--kernel")) scene.ensemble.kernel = parse_kernel(r.kernel);
   if (r.no_plots) scene.plots = false;
   if (given("--out")) {
     if (r.out.empty()) throw BadInput("--out: '' is not a directory name");
