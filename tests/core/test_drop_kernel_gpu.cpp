@@ -17,15 +17,16 @@ namespace {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-void require_device() {
+// Empty when a device can be used, else why not (GTEST_SKIP must be in the test body to end it).
+std::string no_device() {
   std::string why;
-  if (!gpu::device_available(&why)) GTEST_SKIP() << "no CUDA device: " << why;
+  return gpu::device_available(&why) ? std::string() : "no CUDA device: " + why;
 }
 
 }  // namespace
 
 TEST(DropKernelGpu, DrawsEqualTheScalarReference) {
-  require_device();
+  if (const std::string why = no_device(); !why.empty()) GTEST_SKIP() << why;
   for (std::uint64_t first : {std::uint64_t{0}, std::uint64_t{(1ull << 32) - 100}}) {
     constexpr std::size_t n = 100003;
     std::vector<Vec3> d(n);
@@ -40,7 +41,7 @@ TEST(DropKernelGpu, DrawsEqualTheScalarReference) {
 }
 
 TEST(DropKernelGpu, ContactsEqualTheScalarReference) {
-  require_device();
+  if (const std::string why = no_device(); !why.empty()) GTEST_SKIP() << why;
   const auto centres = make_rough_sphere(SphereParams{20000, 3e-3, 6.5e-7}, 5, 0).centres;
   const auto grid = make_contact_query(Backend::grid, centres);
   constexpr std::size_t n = 20000;
