@@ -83,13 +83,20 @@ using u32v = std::uint32_t __attribute__((vector_size(4 * kW)));
 using i32v = std::int32_t __attribute__((vector_size(4 * kW)));
 using f64v = double __attribute__((vector_size(8 * kW)));
 
+// Philox's mulhilo for 32-bit lanes. With a 32-bit vector multiply (avx2, avx512f): hi by the
+// widening multiply of even and odd lanes, lo by vpmulld (one loop computing both made GCC pack the
+// products: 4x the instructions). SSE2 has no vpmulld: there the one loop is the shorter.
+template <bool Mul32>
 struct VectorLanes {
-  // Lane by lane, so that GCC sees the widening multiply (vpmuludq on the even and odd lanes)
-  // rather than a full 64 x 64-bit product of widened vectors.
   [[gnu::always_inline]] void operator()(u32v a, std::uint32_t m, u32v& hi, u32v& lo) const {
-    for (std::size_t l = 0; l < kW; ++l) {
-      const std::uint64_t p = static_cast<std::uint64_t>(a[l]) * m;
-      hi[l] = static_cast<std::uint32_t>(p >> 32), lo[l] = static_cast<std::uint32_t>(p);
+    if constexpr (Mul32) {
+      for (std::size_t l = 0; l < kW; ++l) hi[l] = static_cast<std::uint32_t>((static_cast<std::uint64_t>(a[l]) * m) >> 32);
+      lo = a * m;
+    } else {
+      for (std::size_t l = 0; l < kW; ++l) {
+        const std::uint64_t p = static_cast<std::uint64_t>(a[l]) * m;
+        hi[l] = static_cast<std::uint32_t>(p >> 32), lo[l] = static_cast<std::uint32_t>(p);
+      }
     }
   }
   [[gnu::always_inline]] f64v operator()(i32v x) const { return __builtin_convertvector(x, f64v); }
@@ -110,6 +117,7 @@ struct Disk {
 };
 
 // First attempts of disk w for drops first .. first + kW - 1, rejected lanes finished by the scalar code.
+template <class Lanes>
 [[gnu::always_inline]] inline Disk disk_lanes(std::uint64_t seed, std::uint64_t first, std::uint32_t w) {
   // Counter (index lo, index hi, w, purpose) of drops first + l: the low words with their carry.
   const u32v zero = {}, iota = {0, 1, 2, 3, 4, 5, 6, 7};
@@ -117,7 +125,7 @@ struct Disk {
   const u32v lo = zero + lo0 + iota;
   const u32v wrapped = reinterpret_cast<u32v>(lo < lo0);  // all ones where the low word wrapped
   u32v c[4] = {lo, zero + static_cast<std::uint32_t>(first >> 32) - wrapped, zero + w, zero + kernel::kPurposeDrop};
-  const VectorLanes L;
+  const Lanes L;
   kernel::philox4x32_10(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L);
   const u32v flip = c[1] ^ 0x80000000u, flip3 = c[3] ^ 0x80000000u;
   Disk k;
@@ -134,12 +142,12 @@ struct Disk {
   return k;
 }
 
-template <class Sqrt>
+template <class Lanes, class Sqrt>
 [[gnu::always_inline]] inline void draw_simd(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
   const std::size_t n = d.size();
   for (std::size_t i = 0; i < n; i += kW) {
     // A tail shorter than kW computes whole vectors and stores its lanes only.
-    const Disk p = disk_lanes(seed, first + i, 0), q = disk_lanes(seed, first + i, 1);
+    const Disk p = disk_lanes<Lanes>(seed, first + i, 0), q = disk_lanes<Lanes>(seed, first + i, 1);
     f64v dx, dy, dz, cc, sn;
     kernel::sphere_point(p.x, p.y, p.s, dx, dy, dz, Sqrt{});
     kernel::azimuth(q.x, q.y, q.s, cc, sn, Sqrt{});
@@ -180,14 +188,14 @@ template <class Sqrt>
 // compiled for each target; the default one is SSE2, which every x86-64 has.
 __attribute__((target("avx512f"))) void draw_avx512(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
                                                      std::span<double> c, std::span<double> s) {
-  draw_simd<VectorSqrt>(seed, first, d, c, s);
+  draw_simd<VectorLanes<true>, VectorSqrt>(seed, first, d, c, s);
 }
 __attribute__((target("avx2"))) void draw_avx2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
                                                std::span<double> c, std::span<double> s) {
-  draw_simd<VectorSqrt>(seed, first, d, c, s);
+  draw_simd<VectorLanes<true>, VectorSqrt>(seed, first, d, c, s);
 }
 void draw_sse2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
-  draw_simd<VectorSqrt>(seed, first, d, c, s);
+  draw_simd<VectorLanes<false>, VectorSqrt>(seed, first, d, c, s);
 }
 __attribute__((target("avx512f"))) void contacts_avx512(std::span<const Vec3> d, std::span<const double> c,
                                                         std::span<const double> s, std::span<const Nearest> nn,
@@ -257,9 +265,11 @@ bool isa_available(SimdIsa isa) {
 }
 
 SimdIsa best_isa() {
-  // Resolved once (the CPU does not change under a running process).
+  // Resolved once (the CPU does not change under a running process). Not SSE2: its variant runs
+  // more instructions than the scalar code (no 32-bit vector multiply; callgrind: 460 against 386
+  // per drop), so a CPU without AVX2 runs the scalar reference.
   static const SimdIsa best = [] {
-    for (SimdIsa i : {SimdIsa::avx512f, SimdIsa::avx2, SimdIsa::sse2})
+    for (SimdIsa i : {SimdIsa::avx512f, SimdIsa::avx2})
       if (isa_available(i)) return i;
     return SimdIsa::none;
   }();

@@ -14,7 +14,7 @@ enum class SimdIsa { none, sse2, avx2, avx512f };
 
 /// Whether this build and CPU can run `isa`.
 bool isa_available(SimdIsa isa);
-/// The widest available one: what Kernel::simd runs.
+/// What Kernel::simd runs: avx512f, else avx2, else none (the SSE2 variant is slower than scalar).
 SimdIsa best_isa();
 
 /// draw_drops / drop_contacts by one variant; throws std::invalid_argument where !isa_available(isa).
