@@ -88,7 +88,7 @@ void validate(const EnsembleConfig& c) {
                                 "statistics = raw (or auto)");
   if (!kernel_available(c.kernel))
     throw std::invalid_argument("kernel = \"" + std::string(to_string(c.kernel)) +
-                                "\": this build has no CUDA backend (kernels here: scalar, simd)");
+                                "\": the explicit drops have no CUDA backend yet (kernels: scalar, simd)");
   if (c.bins_log2 < 10 || c.bins_log2 > 24)
     throw std::invalid_argument("bins_log2 (2^k streaming bins) must be in [10, 24], got " + std::to_string(c.bins_log2));
   if (uses_streaming(c) && c.drops > kMaxStreamingDrops)

@@ -144,7 +144,7 @@ TEST(Cli, ARejectedLawExitsWith1) {
 TEST(Cli, ScalarAndSimdKernelsOnOneAndTwoThreadsWriteTheSameReport) {
   // The drop kernel's instantiations (core/drop_kernel.hpp), raw samples and streaming statistics.
   for (const std::string run_args : {"--asperities 500 --drops 20000 --spheres 20",
-                                     "--asperities 1000 --drops 400000 --spheres 100 --statistics streaming"}) {
+                                     "--asperities 1000 --drops 200000 --spheres 50 --statistics streaming"}) {
     const fs::path a = fresh_dir("kernel-scalar"), b = fresh_dir("kernel-simd");
     const CliRun ra = run(run_args + " --no-plots --kernel scalar --threads 1 --out " + a.string());
     const CliRun rb = run(run_args + " --no-plots --kernel simd --threads 2 --out " + b.string());
