@@ -60,6 +60,7 @@ TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
       {"--seed x1", "x1"},                {"--mode fixed --spheres 3 --drops 1000", "multiple"},
       {"--spheres 0 --mode fixed", "'0'"}, {"--frobnicate 3", "frobnicate"},
       {"--kernel avx", "avx"},            {"--kernel gpu", "CUDA"},
+      {"--kernel scalar --mode sampled", "--kernel"},
   };
   for (const auto& c : cases) {
     const fs::path out = fresh_dir("bad");

@@ -447,6 +447,15 @@ void apply_streaming_options(Scene& scene, const RawOptions& r, const Given& giv
     refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
 }
 
+// --kernel: the drop kernel of explicit sphere drops. It changes no bit, so it may come with
+// --resume; validate() refuses one this build lacks.
+void apply_kernel_option(Scene& scene, const RawOptions& r, const RunKind& k) {
+  scene.ensemble.kernel = parse_kernel(r.kernel);
+  if (k.bounce || k.mesh || k.radii) refuse("--kernel", "not used by " + k.text + " (explicit sphere drops only)");
+  if (scene.ensemble.mode != Mode::explicit_spheres)
+    refuse("--kernel", "only for the explicit design (explicit spheres); sampled drops run no drop kernel: add --mode explicit");
+}
+
 // --resume DIR: the checkpoint's own scene; only options that change no result may come with it.
 void check_resume_option(const RawOptions& r, const Given& given) {
   for (const char* o : {"--scene", "--asperities", "--radius", "--asperity-radius", "--drops", "--mode", "--spheres",
@@ -472,8 +481,6 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
                      "decide nothing (exit status 0)");
     scene.alpha = a;
   }
-  // The drop kernel changes no bit (so it may come with --resume); validate() refuses one not built.
-  if (given("--kernel")) scene.ensemble.kernel = parse_kernel(r.kernel);
   if (r.no_plots) scene.plots = false;
   if (given("--out")) {
     if (r.out.empty()) throw BadInput("--out: '' is not a directory name");
@@ -497,6 +504,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   apply_design_options(scene, r, given, k);
   apply_impact_options(scene, r, given, k);
   if (given("--backend")) apply_backend_option(scene, r, k);
+  if (given("--kernel")) apply_kernel_option(scene, r, k);
   apply_bounce_options(scene, r, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
   apply_streaming_options(scene, r, given, k);
