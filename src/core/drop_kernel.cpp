@@ -19,6 +19,12 @@
 #else
 #define ASPERITY_DROP_SIMD 0  // other compilers: simd runs the scalar reference (the same bits)
 #endif
+// The scalar reference is never auto-vectorised, so that it is what a one-lane machine would do.
+#if defined(__GNUC__) && !defined(__clang__)
+#define ASPERITY_NO_VECTORIZE __attribute__((optimize("no-tree-vectorize")))
+#else
+#define ASPERITY_NO_VECTORIZE
+#endif
 
 namespace asperity {
 
@@ -48,8 +54,7 @@ double gap_of(double k1, double k2, double R) {
   return std::isfinite(k2) ? 0.5 * R * (k2 - k1) : std::numeric_limits<double>::infinity();
 }
 
-// The scalar reference: never auto-vectorised, so that it is what a one-lane machine would do.
-__attribute__((optimize("no-tree-vectorize"))) void draw_scalar(std::uint64_t seed, std::uint64_t first,
+ASPERITY_NO_VECTORIZE void draw_scalar(std::uint64_t seed, std::uint64_t first,
                                                                  std::span<Vec3> d, std::span<double> c,
                                                                  std::span<double> s) {
   for (std::size_t i = 0; i < d.size(); ++i) {
@@ -59,7 +64,7 @@ __attribute__((optimize("no-tree-vectorize"))) void draw_scalar(std::uint64_t se
   }
 }
 
-__attribute__((optimize("no-tree-vectorize"))) void contacts_scalar(std::span<const Vec3> d, std::span<const double> c,
+ASPERITY_NO_VECTORIZE void contacts_scalar(std::span<const Vec3> d, std::span<const double> c,
                                                                      std::span<const double> s,
                                                                      std::span<const Nearest> nn,
                                                                      std::span<const Vec3> centres, double R, double a,
