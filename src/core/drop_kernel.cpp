@@ -16,6 +16,7 @@
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define ASPERITY_DROP_SIMD 1
+#include <immintrin.h>
 #else
 #define ASPERITY_DROP_SIMD 0  // other compilers: simd runs the scalar reference (the same bits)
 #endif
@@ -106,6 +107,38 @@ struct VectorLanes {
     }
   }
   [[gnu::always_inline]] f64v operator()(i32v x) const { return __builtin_convertvector(x, f64v); }
+  [[gnu::always_inline]] void philox(u32v (&c)[4], std::uint32_t k0, std::uint32_t k1) const {
+    kernel::philox4x32_10(c, k0, k1, *this);
+  }
+};
+
+// Philox4x32-10 on eight lanes with AVX2 intrinsics: the same operations as philox4x32_10 (the test
+// compares every variant with the scalar reference bit for bit), but hi without packing: vpmuludq on
+// the even and on the odd lanes, the high words blended into place (~18 instead of ~46 instructions
+// per round). Out of line: a function of another target cannot be inlined into the generic templates.
+__attribute__((target("avx2"))) void philox_avx2(u32v (&c)[4], std::uint32_t k0, std::uint32_t k1) {
+  __m256i x[4];
+  std::memcpy(x, c, sizeof x);
+  const __m256i m0 = _mm256_set1_epi32(static_cast<int>(0xD2511F53u)), m1 = _mm256_set1_epi32(static_cast<int>(0xCD9E8D57u));
+  auto mulhi = [](__m256i a, __m256i m) __attribute__((target("avx2"))) {
+    const __m256i even = _mm256_srli_epi64(_mm256_mul_epu32(a, m), 32);
+    const __m256i odd = _mm256_mul_epu32(_mm256_srli_epi64(a, 32), m);
+    return _mm256_blend_epi32(even, odd, 0xAA);
+  };
+  for (int r = 0; r < 10; ++r) {
+    const __m256i hi0 = mulhi(x[0], m0), lo0 = _mm256_mullo_epi32(x[0], m0);
+    const __m256i hi1 = mulhi(x[2], m1), lo1 = _mm256_mullo_epi32(x[2], m1);
+    const __m256i key0 = _mm256_set1_epi32(static_cast<int>(k0)), key1 = _mm256_set1_epi32(static_cast<int>(k1));
+    x[0] = _mm256_xor_si256(_mm256_xor_si256(hi1, x[1]), key0);
+    x[1] = lo1;
+    x[2] = _mm256_xor_si256(_mm256_xor_si256(hi0, x[3]), key1);
+    x[3] = lo0;
+    k0 += 0x9E3779B9u, k1 += 0xBB67AE85u;
+  }
+  std::memcpy(c, x, sizeof x);
+}
+struct Avx2Lanes : VectorLanes<true> {
+  void philox(u32v (&c)[4], std::uint32_t k0, std::uint32_t k1) const { philox_avx2(c, k0, k1); }
 };
 struct VectorSqrt {
   // Lane by lane; GCC emits the vector sqrt (IEEE, correctly rounded) given -fno-math-errno and
@@ -132,7 +165,7 @@ template <class Lanes>
   const u32v wrapped = reinterpret_cast<u32v>(lo < lo0);  // all ones where the low word wrapped
   u32v c[4] = {lo, zero + static_cast<std::uint32_t>(first >> 32) - wrapped, zero + w, zero + kernel::kPurposeDrop};
   const Lanes L;
-  kernel::philox4x32_10(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L);
+  L.philox(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32));
   const u32v flip = c[1] ^ 0x80000000u, flip3 = c[3] ^ 0x80000000u;
   Disk k;
   k.x = kernel::coordinate<f64v>(reinterpret_cast<i32v>(c[0]), reinterpret_cast<i32v>(flip), L);
@@ -194,11 +227,11 @@ template <class Sqrt>
 // compiled for each target; the default one is SSE2, which every x86-64 has.
 __attribute__((target("avx512f"))) void draw_avx512(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
                                                      std::span<double> c, std::span<double> s) {
-  draw_simd<VectorLanes<true>, VectorSqrt>(seed, first, d, c, s);
+  draw_simd<Avx2Lanes, VectorSqrt>(seed, first, d, c, s);
 }
 __attribute__((target("avx2"))) void draw_avx2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d,
                                                std::span<double> c, std::span<double> s) {
-  draw_simd<VectorLanes<true>, VectorSqrt>(seed, first, d, c, s);
+  draw_simd<Avx2Lanes, VectorSqrt>(seed, first, d, c, s);
 }
 void draw_sse2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
   draw_simd<VectorLanes<false>, VectorSqrt>(seed, first, d, c, s);
@@ -259,7 +292,7 @@ namespace detail {
 bool isa_available(SimdIsa isa) {
 #if ASPERITY_DROP_SIMD
   switch (isa) {
-    case SimdIsa::avx512f: return __builtin_cpu_supports("avx512f");
+    case SimdIsa::avx512f: return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2");  // its Philox is AVX2's
     case SimdIsa::avx2: return __builtin_cpu_supports("avx2");
     case SimdIsa::sse2: return true;
     case SimdIsa::none: return true;
