@@ -579,6 +579,14 @@ void read_ensemble(Reader& top, Scene& s) {
     ens->bad("drops", std::to_string(e.drops) + " must be a multiple of ensemble.spheres = " + std::to_string(e.spheres));
   read_seed(*ens, e.seed);
   read_backend(*ens, s);
+  // Which drop kernel instantiation runs the explicit drops (the same bits; validate() refuses one
+  // this build lacks).
+  if (auto k = ens->choice("kernel", {"scalar", "simd", "gpu"})) {
+    e.kernel = parse_kernel(*k);
+    if (e.mode == Mode::sampled)  // a key that cannot apply is refused, never ignored
+      ens->bad("kernel", "only mode = \"explicit\" runs the drop kernel (sampled draws the lowest asperities from "
+                         "the exact law), got \"" + *k + "\"");
+  }
   if (auto t = ens->count("threads", 0, std::uint64_t(kMaxThreads))) e.threads = static_cast<int>(*t);
   if (auto st = ens->choice("statistics", {"auto", "raw", "streaming"})) e.statistics = parse_statistics(*st);
   if (auto b = ens->count("bins_log2", 10, 24)) e.bins_log2 = static_cast<unsigned>(*b);
@@ -1058,6 +1066,8 @@ void write_ensemble(std::ostream& os, const Scene& s) {
      << e.threads << "\n";
   if (e.statistics != Statistics::automatic) os << "statistics = \"" << to_string(e.statistics) << "\"\n";
   if (e.bins_log2 != EnsembleConfig{}.bins_log2) os << "bins_log2 = " << e.bins_log2 << "\n";
+  if (e.mode == Mode::explicit_spheres && e.kernel != EnsembleConfig{}.kernel)
+    os << "kernel = \"" << to_string(e.kernel) << "\"\n";
   os << "\n";
 }
 

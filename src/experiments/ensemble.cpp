@@ -87,6 +87,9 @@ void validate(const EnsembleConfig& c) {
   if (c.statistics == Statistics::streaming && c.impact.enabled)
     throw std::invalid_argument("statistics = streaming keeps contact statistics only; the impact experiment needs "
                                 "statistics = raw (or auto)");
+  if (!kernel_available(c.kernel))
+    throw std::invalid_argument("kernel = \"" + std::string(to_string(c.kernel)) +
+                                "\": the explicit drops have no CUDA backend yet (kernels: scalar, simd)");
   if (c.bins_log2 < 10 || c.bins_log2 > 24)
     throw std::invalid_argument("bins_log2 (2^k streaming bins) must be in [10, 24], got " + std::to_string(c.bins_log2));
   if (uses_streaming(c) && c.drops > kMaxStreamingDrops)
@@ -339,7 +342,7 @@ using Answers = std::vector<std::pair<Vec3, Nearest>>;
 void rotate(const EnsembleConfig& c, const detail::CheckPlan& plan, const RoughSphere& body, const ContactQuery& index,
             std::uint64_t k, std::uint64_t b, std::uint64_t e, Answers* checks, ContactSamples& s) {
   const std::uint64_t m = c.drops / c.spheres;
-  detail::query_rotations(c, m, body.centres, index, k, b, e,
+  detail::query_drops(c, m, body.centres, index, k, b, e,
                           [&](std::uint64_t j, const Contact& contact, const Vec3& down, const Nearest& r) {
                             store(s, k * m + j, contact);
                             if (checks && j % plan.stride == 0 && checks->size() < plan.per_sphere)

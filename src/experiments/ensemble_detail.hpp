@@ -11,47 +11,40 @@
 #include <vector>
 
 #include "asperity/core/contact.hpp"
+#include "asperity/core/drop_kernel.hpp"
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
 #include "asperity/experiments/ensemble.hpp"
 
 namespace asperity::detail {
 
-/// The rotation of explicit drop `drop` (index k m + j): Marsaglia's trig-free Haar draw from the
-/// drop's own stream. Shared by the drop loop and the streaming run's cross-check.
-inline Rotation drop_rotation(const EnsembleConfig& c, std::uint64_t drop) {
-  Stream st(c.seed, Purpose::orientation, drop);
-  return random_rotation_marsaglia(st);
-}
+/// The body-frame down direction of explicit drop `drop` (index k m + j): the drop kernel's
+/// stream (core/drop_kernel.hpp). Shared by the drop loop and the streaming run's cross-check.
+inline Vec3 drop_direction(const EnsembleConfig& c, std::uint64_t drop) { return draw_drop(c.seed, drop).d; }
 
-/// Rotations [b, e) of sphere k (m rotations per sphere): drop k m + j, one Haar rotation from
-/// its own stream, the lowest asperity by one batched query. The one definition of an explicit
-/// drop, so that both drivers see the same drops. `each(j, contact, down, nearest)` per rotation,
-/// in order of j. Batches of kQueryBatch rotations: their buffers (~20 KiB) stay in L1/L2 next to
-/// the index and the histograms (answers do not depend on the batching).
+/// Drops [b, e) of sphere k (m drops per sphere): drop k m + j, a down direction and a world
+/// azimuth from its own stream, the lowest asperity by one batched query, the contact by the drop
+/// kernel (c.kernel: scalar or simd, the same bits). The one definition of an explicit drop, so
+/// that both drivers see the same drops. `each(j, contact, down, nearest)` per drop, in order of j.
+/// Batches of kQueryBatch drops: their buffers (~40 KiB) stay in L1/L2 next to the index and the
+/// histograms (answers do not depend on the batching).
 inline constexpr std::uint64_t kQueryBatch = 256;
 template <class Each>
-void query_rotations(const EnsembleConfig& c, std::uint64_t m, std::span<const Vec3> centres, const ContactQuery& index,
-                     std::uint64_t k, std::uint64_t b, std::uint64_t e, Each&& each) {
-  std::array<Rotation, kQueryBatch> q;
+void query_drops(const EnsembleConfig& c, std::uint64_t m, std::span<const Vec3> centres, const ContactQuery& index,
+                 std::uint64_t k, std::uint64_t b, std::uint64_t e, Each&& each) {
   std::array<Vec3, kQueryBatch> d;
+  std::array<double, kQueryBatch> cs, sn;
   std::array<Nearest, kQueryBatch> nn;
+  std::array<Contact, kQueryBatch> ct;
   for (std::uint64_t lo = b; lo < e; lo += kQueryBatch) {
     const std::size_t n = static_cast<std::size_t>(std::min(kQueryBatch, e - lo));
-    for (std::size_t i = 0; i < n; ++i) {
-      q[i] = drop_rotation(c, k * m + lo + i);
-      d[i] = body_down(q[i]);
-    }
-    index.lowest(std::span<const Vec3>(d.data(), n), std::span<Nearest>(nn.data(), n));
-    // The touching asperity's centre is a random read of the centres (N = 10^5: 2.4 MB, a cache
-    // miss per drop, ~17% of the run): prefetched kCentreLag drops ahead.
-    constexpr std::size_t kCentreLag = 16;
-    for (std::size_t i = 0; i < std::min(n, kCentreLag); ++i) __builtin_prefetch(centres.data() + nn[i].index);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (i + kCentreLag < n) __builtin_prefetch(centres.data() + nn[i + kCentreLag].index);
-      const Nearest& r = nn[i];
-      each(lo + i, make_contact(r, centres[r.index], q[i], c.sphere.radius, c.sphere.asperity_radius), d[i], r);
-    }
+    const std::span<Vec3> dn(d.data(), n);
+    draw_drops(c.kernel, c.seed, k * m + lo, dn, std::span<double>(cs.data(), n), std::span<double>(sn.data(), n));
+    index.lowest(dn, std::span<Nearest>(nn.data(), n));
+    drop_contacts(c.kernel, dn, std::span<const double>(cs.data(), n), std::span<const double>(sn.data(), n),
+                  std::span<const Nearest>(nn.data(), n), centres, c.sphere.radius, c.sphere.asperity_radius,
+                  std::span<Contact>(ct.data(), n));
+    for (std::size_t i = 0; i < n; ++i) each(lo + i, ct[i], d[i], nn[i]);
   }
 }
 

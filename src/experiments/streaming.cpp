@@ -150,7 +150,7 @@ struct Driver {
   void explicit_unit(const Built& b, std::uint64_t k, std::uint64_t j, int t, Slot& slot) const {
     const std::uint64_t lo = j * kUnit, hi = std::min(m, lo + kUnit);
     const std::size_t g = sink.block(k);
-    detail::query_rotations(c, m, b.body.centres, *b.index, k, lo, hi,
+    detail::query_drops(c, m, b.body.centres, *b.index, k, lo, hi,
                             [&](std::uint64_t, const Contact& contact, const Vec3&, const Nearest&) {
                               sink.count(t, g, contact, slot);
                             });
@@ -171,7 +171,7 @@ struct Driver {
   detail::SphereCheck check(const Built& b, std::uint64_t k) const {
     std::vector<std::pair<Vec3, Nearest>> answers;
     for (std::uint64_t r = 0; r < m && answers.size() < plan.per_sphere; r += plan.stride) {
-      const Vec3 d = body_down(detail::drop_rotation(c, k * m + r));
+      const Vec3 d = detail::drop_direction(c, k * m + r);
       answers.emplace_back(d, b.index->lowest(d));
     }
     return detail::cross_check_sphere(c, b.body.centres, answers, plan.others, k);

@@ -16,6 +16,7 @@
 #include "asperity/app/plot.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "app/cli/progress_line.hpp"
+#include "comparable_report.hpp"
 #include "run_command.hpp"
 
 namespace fs = std::filesystem;
@@ -59,6 +60,8 @@ TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
       {"--alpha nan", "alpha"},           {"--threads -1", "-1"},             {"--seed -3", "-3"},
       {"--seed x1", "x1"},                {"--mode fixed --spheres 3 --drops 1000", "multiple"},
       {"--spheres 0 --mode fixed", "'0'"}, {"--frobnicate 3", "frobnicate"},
+      {"--kernel avx", "avx"},            {"--kernel gpu", "CUDA"},
+      {"--kernel scalar --mode sampled", "--kernel"},
   };
   for (const auto& c : cases) {
     const fs::path out = fresh_dir("bad");
@@ -138,6 +141,22 @@ TEST(Cli, ARejectedLawExitsWith1) {
     if (t.at("law") == "eq18" && t.at("decisive") == true && t.at("verdict") == "reject") eq18_rejected = true;
   EXPECT_TRUE(eq18_rejected) << r.out;
   fs::remove_all(out);
+}
+
+TEST(Cli, ScalarAndSimdKernelsOnOneAndTwoThreadsWriteTheSameReport) {
+  // The drop kernel's instantiations (core/drop_kernel.hpp), raw samples and streaming statistics.
+  for (const std::string run_args : {"--asperities 500 --drops 20000 --spheres 20",
+                                     "--asperities 1000 --drops 200000 --spheres 50 --statistics streaming"}) {
+    const fs::path a = fresh_dir("kernel-scalar"), b = fresh_dir("kernel-simd");
+    const CliRun ra = run(run_args + " --no-plots --kernel scalar --threads 1 --out " + a.string());
+    const CliRun rb = run(run_args + " --no-plots --kernel simd --threads 2 --out " + b.string());
+    EXPECT_TRUE(ra.status == 0 || ra.status == 1) << ra.out;
+    EXPECT_EQ(ra.status, rb.status) << rb.out;
+    EXPECT_EQ(asperity::testing::comparable_report(a / "report.json"), asperity::testing::comparable_report(b / "report.json"))
+        << run_args;
+    fs::remove_all(a);
+    fs::remove_all(b);
+  }
 }
 
 TEST(Cli, OneSphereIsReportedAsItsOwnLawAndDecidesNothing) {

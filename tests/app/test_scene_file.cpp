@@ -144,6 +144,7 @@ TEST(SceneFile, RoundTripsThroughToToml) {
   odd.ensemble.impact.omega = Vec3(-1e-300, 5e3, 1.0 / 3.0);
   odd.ensemble.backend = Backend::cgal;
   odd.backend_auto = false;
+  odd.ensemble.kernel = Kernel::scalar;
   odd.contact_stats = false;
   odd.plots = true;
   scenes.push_back(odd);
@@ -164,6 +165,15 @@ TEST(SceneFile, RoundTripsThroughToToml) {
   fresh_with_backend.ensemble.backend = Backend::grid;
   fresh_with_backend.backend_auto = false;
   EXPECT_TRUE(parse_scene(to_toml(fresh_with_backend)).backend_auto);
+  // ensemble.kernel: read, and refused where it cannot apply (sampled drops run no drop kernel).
+  EXPECT_EQ(parse_scene(replace(good, "[ensemble]", "[ensemble]\nkernel = \"scalar\"")).ensemble.kernel, Kernel::scalar);
+  try {
+    parse_scene(replace(replace(replace(good, "mode = \"explicit\"", "mode = \"sampled\""), "spheres = 10\n", ""),
+                        "[ensemble]", "[ensemble]\nkernel = \"scalar\""));
+    ADD_FAILURE() << "kernel with mode = \"sampled\" was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("ensemble.kernel"), std::string::npos) << e.what();
+  }
   expect_round_trips(scenes);
 }
 

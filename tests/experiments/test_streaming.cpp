@@ -70,6 +70,15 @@ TEST(Streaming, SameBitsForOneAndTwoThreads) {
     EXPECT_TRUE(run(c, 1) == run(c, 2)) << to_string(c.mode) << " K = " << c.spheres;
 }
 
+TEST(Streaming, SameBitsForScalarAndSimdKernels) {
+  // The drop kernel's instantiations (core/drop_kernel.hpp): scalar on one thread, simd on two.
+  for (const auto& base : {config(Mode::explicit_spheres, 16, 16 * 1000), config(Mode::explicit_spheres, 2, 2 * 20000, 30000)}) {
+    EnsembleConfig scalar = base, simd = base;
+    scalar.kernel = Kernel::scalar, simd.kernel = Kernel::simd;
+    EXPECT_TRUE(run(scalar, 1) == run(simd, 2)) << " K = " << base.spheres;
+  }
+}
+
 TEST(Streaming, InterruptedAndResumedEqualsUninterrupted) {
   for (const auto& c : {config(Mode::explicit_spheres, 2, 2 * 80000), config(Mode::sampled, 1, 70000)}) {
     const StreamState whole = run(c, 2);

@@ -19,6 +19,7 @@ enum class Purpose : std::uint32_t {
   lazy_sphere = 5,  ///< counts and centres of the cells of one lazy sphere (lazy_sphere.hpp)
   bounce = 6,       ///< per-sequence draws of a bounce sequence (initial orientation, paper laws)
   bootstrap = 7,    ///< replicates of a sphere-block bootstrap (laws/block_ks.hpp)
+  drop = 8,         ///< direction and azimuth of an explicit drop (Philox4x32 blocks, core/drop_kernel.hpp)
   test = 99,        ///< reserved for tests
 };
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "asperity/core/contact.hpp"
+#include "asperity/core/drop_kernel.hpp"
 #include "asperity/core/tangential.hpp"
 #include "asperity/core/geometry.hpp"
 
@@ -113,6 +114,7 @@ struct EnsembleConfig {
   std::uint64_t spheres = 1;      ///< K (explicit design); drops must be a multiple of K
   std::uint64_t seed = 1;
   Backend backend = Backend::grid;  ///< explicit design only
+  Kernel kernel = Kernel::simd;     ///< explicit design: which drop kernel instantiation (the same bits)
   int threads = 0;                  ///< 0 = OpenMP default, at most kMaxThreads
   ImpactExperiment impact;          ///< off: contact statistics only (nothing else is computed)
   Statistics statistics = Statistics::automatic;

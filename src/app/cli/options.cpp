@@ -143,6 +143,7 @@ struct RawOptions {
   std::string speed, omega_x, omega_y;
   std::string variants, sequences;
   std::string tangential;
+  std::string kernel;
 };
 
 void add_options(CLI::App& app, RawOptions& r) {
@@ -160,6 +161,7 @@ void add_options(CLI::App& app, RawOptions& r) {
   app.add_option("--seed", r.seed, "random seed (results are identical for any thread count)");
   app.add_option("--backend", r.backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
   app.add_option("--threads", r.threads, "OpenMP threads (0 = all)");
+  app.add_option("--kernel", r.kernel, "drop kernel of the explicit drops: simd (default) or scalar (the reference; the same bits)");
   app.add_option("--statistics", r.statistics,
                  "auto (default: streaming above 2^25 drops without impacts), raw (every drop kept: exact KS, figures "
                  "of every quantity) or streaming (integer histograms, memory independent of the drops; contact only)");
@@ -167,8 +169,8 @@ void add_options(CLI::App& app, RawOptions& r) {
   app.add_option("--checkpoint-every", r.checkpoint_every,
                  "streaming: seconds between checkpoints in --out (default 300; 0: only on SIGINT/SIGTERM)");
   app.add_option("--resume", r.resume,
-                 "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only --threads, --quiet, "
-                 "--no-plots, --checkpoint-every may be given)")
+                 "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only --threads, --kernel, "
+                 "--quiet, --no-plots, --checkpoint-every may be given)")
       ->excludes(preset_opt);
   app.add_option("--alpha", r.alpha, "significance level of each test, in (0,1)");
   app.add_option("--out", r.out, "output directory for report.json and figures");
@@ -488,14 +490,23 @@ void refuse_unused_streaming_options(const Scene& scene, const Given& given) {
          "the option out)");
 }
 
+// --kernel: the drop kernel of explicit sphere drops. It changes no bit, so it may come with
+// --resume; validate() refuses one this build lacks.
+void apply_kernel_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
+  scene.ensemble.kernel = parse_kernel(r.kernel);
+  if (k.bounce || k.mesh || k.radii) refuse("--kernel", "not used by " + k.text + " (explicit sphere drops only)");
+  if (scene.ensemble.mode != Mode::explicit_spheres)
+    refuse("--kernel", "only for the explicit design (explicit spheres); sampled drops run no drop kernel: add --mode explicit");
+}
+
 // --resume DIR: the checkpoint's own scene; only options that change no result may come with it.
 void check_resume_option(const RawOptions& r, const Given& given) {
   for (const char* o : {"--scene", "--asperities", "--radius", "--asperity-radius", "--drops", "--mode", "--spheres",
                         "--seed", "--backend", "--alpha", "--out", "--speed", "--omega-x", "--omega-y", "--variant",
                         "--sequences", "--statistics", "--bins-log2", "--tangential"})
     if (given(o))
-      throw BadInput(std::string(o) + ": --resume continues the checkpoint's own scene; only --threads, --quiet, "
-                                      "--no-plots and --checkpoint-every may be given with it");
+      throw BadInput(std::string(o) + ": --resume continues the checkpoint's own scene; only --threads, --kernel, "
+                                      "--quiet, --no-plots and --checkpoint-every may be given with it");
   if (r.resume.empty()) throw BadInput("--resume: '' is not a directory name");
 }
 
@@ -544,6 +555,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   apply_design_options(scene, r, given, k);
   apply_impact_options(scene, r, given, k);
   if (given("--backend")) apply_backend_option(scene, r, k);
+  if (given("--kernel")) apply_kernel_option(scene, r, k);
   apply_bounce_options(scene, r, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
   apply_streaming_options(scene, r, given, k);
