@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Tables and report.json bodies of the experiments beyond the paper (radii, mesh impacts).
+#include "checked_text.hpp"
 #include "asperity/app/experiment_reports.hpp"
 
 #include "asperity/app/plot.hpp"
@@ -70,7 +71,7 @@ std::string format_table(const RadiiReport& r) {
   }
   os << ", core contacts " << r.core_contacts << ", std(r_x) = " << r.rx_std.value << " +- " << r.rx_std.se << " m\n";
   write_tests(os, r.tests, "qty", 6, 24, true);
-  return os.str();
+  return detail::checked_text(std::move(os), "report.txt");
 }
 
 std::string to_json(const RadiiReport& r) {
@@ -133,7 +134,7 @@ std::string format_table(const MeshImpactReport& r) {
     os << "\n";
   }
   write_tests(os, r.tests, "quantity", 15, 28, false);
-  return os.str();
+  return detail::checked_text(std::move(os), "report.txt");
 }
 
 std::string to_json(const MeshImpactReport& r) {

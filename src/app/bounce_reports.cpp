@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Tables, report.json bodies and figures of bounce runs (spheres and mesh bodies).
+#include "checked_text.hpp"
 #include "asperity/app/experiment_reports.hpp"
 
 #include "asperity/app/report.hpp"
@@ -101,7 +102,7 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
     o << "res = eps - eps_n(u_k); a, c fit: Eq. 2 fitted to res (no bootstrap); (theory): rates of the semi-analytic law at "
          "impact k (bounce_residual_laws; paper: with Eq. 26's beta1); KS D, p: res against that law (speed windows: its mixture over k).\n";
   }
-  return o.str();
+  return detail::checked_text(std::move(o), "report.txt");
 }
 
 std::string bounce_to_json(const std::string& scene_name, const SphereParams& sphere, const BounceExperiment& b,
@@ -352,7 +353,7 @@ std::string format_table(const MeshBounceReport& r) {
   }
   os << "\n";
   os << format_bounce_table({b.base});
-  return os.str();
+  return detail::checked_text(std::move(os), "report.txt");
 }
 
 std::string to_json(const MeshBounceReport& r) {

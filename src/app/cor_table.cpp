@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "checked_text.hpp"
 #include "asperity/app/cor_table.hpp"
 
 #include <nlohmann/json.hpp>
@@ -235,7 +236,7 @@ std::string cor_table_csv(const CorTable& t) {
       write_quantiles(o, r.omega_x_band_quantiles[b]);
     }
   }
-  return o.str();
+  return detail::checked_text(std::move(o), "the restitution table");
 }
 
 std::string cor_table_json(const CorTable& t) {

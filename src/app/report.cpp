@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
+#include "checked_text.hpp"
 #include "asperity/app/report.hpp"
 
 #include "asperity/app/atomic_file.hpp"
@@ -580,7 +581,7 @@ std::string format_table(const GeometryReport& r) {
   for (const auto& t : r.tests)  // the rows show the others
     if (unresolved(t))
       os << to_string(t.verdict) << ": " << t.quantity << " " << t.law << " (" << t.scope << "): " << t.note << "\n";
-  return os.str();
+  return detail::checked_text(std::move(os), "report.txt");
 }
 
 namespace {
