@@ -7,10 +7,14 @@
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 #include <CGAL/Surface_mesh.h>
 
+#include <charconv>
 #include <cmath>
+#include <cctype>
+#include <cstring>
 #include <fstream>
 #include <new>
 #include <sstream>
+#include <new>
 #include <stdexcept>
 #include <vector>
 
@@ -111,17 +115,140 @@ TriangleMesh read_mesh(const std::filesystem::path& file, double scale) {
   return m;
 }
 
+namespace {
+
+// %.9g, what the export always wrote (ostream precision 9): 1 nm at 1 m.
+constexpr std::uint64_t kPlyNumber = 16;  // the widest: "-1.23456789e-100"
+void put(std::string& s, double v) {
+  char b[32];
+  const auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::general, 9);
+  s.append(b, r.ptr);
+}
+void put(std::string& s, std::uint64_t v) {
+  char b[24];
+  const auto r = std::to_chars(b, b + sizeof b, v);
+  s.append(b, r.ptr);
+}
+std::uint64_t digits(std::uint64_t v) { return v < 10 ? 1 : 1 + digits(v / 10); }
+void put_point(std::string& s, const Vec3& p) {
+  put(s, p.x()), s += ' ', put(s, p.y()), s += ' ', put(s, p.z());
+}
+void put_face(std::string& s, std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+  s += "3 ", put(s, a), s += ' ', put(s, b), s += ' ', put(s, c), s += '\n';
+}
+constexpr std::uint64_t kPlyHeaderMax = 400;  // the header lines without the body's name
+
+}  // namespace
+
+std::uint64_t ply_text_bytes(std::uint64_t n, PlyStyle style, std::uint64_t nbv, std::uint64_t nbf) {
+  const std::uint64_t line3 = 3 * (kPlyNumber + 1);  // "x y z\n"
+  if (style == PlyStyle::points) return kPlyHeaderMax + n * (4 * (kPlyNumber + 1));
+  const std::uint64_t face = 2 + 3 * (digits(12 * n + nbv) + 1);
+  return kPlyHeaderMax + (12 * n + nbv) * line3 + (20 * n + nbf) * face;
+}
+
+namespace {
+
+// OFF: "[ST][C][N][4][n]OFF" then the counts (comments '#' to the end of a line).
+MeshFileSize off_size(std::istream& in) {
+  MeshFileSize z;
+  std::string tok;
+  std::vector<std::uint64_t> n;
+  for (std::string line; n.size() < 2 && std::getline(in, line);) {
+    std::istringstream ls(line.substr(0, line.find('#')));
+    while (n.size() < 2 && ls >> tok) {
+      if (tok.ends_with("OFF")) continue;
+      std::uint64_t v = 0;
+      const auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+      if (r.ec != std::errc() || r.ptr != tok.data() + tok.size()) return z;
+      n.push_back(v);
+    }
+  }
+  if (n.size() == 2) z.vertices = n[0], z.faces = n[1];
+  return z;
+}
+
+// PLY (ASCII or binary: the header is text either way): "element vertex N", "element face N".
+MeshFileSize ply_size(std::istream& in) {
+  MeshFileSize z;
+  for (std::string line; std::getline(in, line) && !line.starts_with("end_header");) {
+    std::istringstream ls(line);
+    std::string element, name;
+    std::uint64_t v = 0;
+    if (!(ls >> element >> name >> v) || element != "element") continue;
+    if (name == "vertex") z.vertices = v;
+    if (name == "face") z.faces = v;
+  }
+  return z;
+}
+
+// Lines counted: OBJ "v " / "f ", ASCII STL "facet" (3 vertices each, merged later).
+MeshFileSize counted_size(std::istream& in, bool stl) {
+  MeshFileSize z;
+  for (std::string line; std::getline(in, line);) {
+    const auto b = line.find_first_not_of(" \t");
+    if (b == std::string::npos) continue;
+    const std::string_view l = std::string_view(line).substr(b);
+    if (stl) {
+      if (l.starts_with("facet")) ++z.faces, z.vertices += 3;
+    } else if (l.starts_with("v ")) {
+      ++z.vertices;
+    } else if (l.starts_with("f ")) {
+      ++z.faces;
+    }
+  }
+  return z;
+}
+
+}  // namespace
+
+MeshFileSize mesh_file_size(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return {};
+  std::string ext = file.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".off") return off_size(in);
+  if (ext == ".ply") return ply_size(in);
+  if (ext == ".obj") return counted_size(in, false);
+  if (ext != ".stl") return {};
+  // Binary STL: an 80-byte header, the face count, 50 bytes per face.
+  char head[84] = {};
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(file, ec);
+  if (in.read(head, sizeof head)) {
+    std::uint32_t n = 0;
+    std::memcpy(&n, head + 80, sizeof n);
+    if (!ec && bytes == 84 + 50 * std::uint64_t(n)) return {3 * std::uint64_t(n), n};
+  }
+  in.clear();
+  in.seekg(0);
+  return counted_size(in, true);
+}
+
 void write_ply(const std::filesystem::path& file, const RoughBody& b, PlyStyle style, double inflate,
                const TriangleMesh* base, const Vec3& base_offset) {
   if (!std::isfinite(inflate) || inflate <= 0) throw std::invalid_argument("inflate must be finite and > 0, got " + num(inflate));
-  std::ostringstream os;
-  os.precision(9);
-  os << "ply\nformat ascii 1.0\ncomment asperity rough body '" << b.name << "', body frame, metres\n";
+  const std::size_t nbv = base ? base->vertices.size() : 0, nbf = base ? base->faces.size() : 0;
+  // One allocation of the bound: no copy while growing (pages never written stay unmapped), and a
+  // failure is std::bad_alloc here, never a silently short text (an ostringstream that cannot grow
+  // sets badbit and drops the rest).
+  std::string os;
+  const std::uint64_t bound =
+      b.name.size() + ply_text_bytes(b.size(), style, style == PlyStyle::points ? 0 : nbv, style == PlyStyle::points ? 0 : nbf);
+  try {
+    os.reserve(bound);
+  } catch (const std::bad_alloc&) {  // named: the export is what did not fit
+    throw std::runtime_error("cannot write " + file.string() + ": out of memory for its text (up to " +
+                             std::to_string(bound / 1000000) + " MB; outputs.export_style = \"points\" is ~15x smaller)");
+  }
+  os += "ply\nformat ascii 1.0\ncomment asperity rough body '" + b.name + "', body frame, metres\n";
   if (style == PlyStyle::points) {
-    os << "element vertex " << b.size() << "\nproperty double x\nproperty double y\nproperty double z\n"
-       << "property double radius\nend_header\n";
-    for (std::size_t i = 0; i < b.size(); ++i)
-      os << b.centres[i].x() << " " << b.centres[i].y() << " " << b.centres[i].z() << " " << b.radii[i] << "\n";
+    os += "element vertex " + std::to_string(b.size()) +
+          "\nproperty double x\nproperty double y\nproperty double z\nproperty double radius\nend_header\n";
+    for (std::size_t i = 0; i < b.size(); ++i) {
+      put_point(os, b.centres[i]);
+      os += ' ', put(os, b.radii[i]), os += '\n';
+    }
   } else {
     // Unit icosahedron.
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
@@ -131,26 +258,18 @@ void write_ply(const std::filesystem::path& file, const RoughBody& b, PlyStyle s
     const int ifc[20][3] = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
                             {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
                             {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
-    const std::size_t nbv = base ? base->vertices.size() : 0, nbf = base ? base->faces.size() : 0;
-    os << "element vertex " << 12 * b.size() + nbv << "\nproperty double x\nproperty double y\nproperty double z\n"
-       << "element face " << 20 * b.size() + nbf << "\nproperty list uchar int vertex_indices\nend_header\n";
+    os += "element vertex " + std::to_string(12 * b.size() + nbv) +
+          "\nproperty double x\nproperty double y\nproperty double z\nelement face " + std::to_string(20 * b.size() + nbf) +
+          "\nproperty list uchar int vertex_indices\nend_header\n";
     for (std::size_t i = 0; i < b.size(); ++i)
-      for (const Vec3& v : iv) {
-        const Vec3 p = b.centres[i] + inflate * b.radii[i] * v;
-        os << p.x() << " " << p.y() << " " << p.z() << "\n";
-      }
-    for (std::size_t k = 0; k < nbv; ++k) {
-      const Vec3 p = base->vertices[k] + base_offset;
-      os << p.x() << " " << p.y() << " " << p.z() << "\n";
-    }
-    for (std::size_t i = 0; i < b.size(); ++i)
-      for (const auto& f : ifc) os << "3 " << 12 * i + f[0] << " " << 12 * i + f[1] << " " << 12 * i + f[2] << "\n";
-    for (std::size_t k = 0; k < nbf; ++k) {
-      const auto& f = base->faces[k];
-      os << "3 " << 12 * b.size() + f[0] << " " << 12 * b.size() + f[1] << " " << 12 * b.size() + f[2] << "\n";
-    }
+      for (const Vec3& v : iv) put_point(os, b.centres[i] + inflate * b.radii[i] * v), os += '\n';
+    for (std::size_t k = 0; k < nbv; ++k) put_point(os, base->vertices[k] + base_offset), os += '\n';
+    for (std::uint64_t i = 0; i < b.size(); ++i)
+      for (const auto& f : ifc) put_face(os, 12 * i + f[0], 12 * i + f[1], 12 * i + f[2]);
+    const std::uint64_t o = 12 * b.size();
+    for (std::size_t k = 0; k < nbf; ++k) put_face(os, o + base->faces[k][0], o + base->faces[k][1], o + base->faces[k][2]);
   }
-  write_file_atomic(file, os.str());
+  write_file_atomic(file, os);
 }
 
 }  // namespace asperity

@@ -24,6 +24,8 @@
 #include "asperity/app/mesh_io.hpp"
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
+#include "asperity/app/resources.hpp"
+#include "checked_text.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/app/stream_report.hpp"
 #include "asperity/app/checkpoint.hpp"
@@ -234,7 +236,7 @@ SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* l
   if (s.plots) plots = write_bounce_plots(dir, reports, parse_plot_formats(s.plot_format));
   o.files = plots;
   const double seconds_plots = since(t0);
-  o.table = table.str();
+  o.table = detail::checked_text(std::move(table), "report.txt");
   const ReportHeader h =
       header_of(s, {stage("bounce", true, "bounce sequences per variant, fits and bootstrap goodness of fit", seconds_bounce),
                     stage("analysis", true, "two-sample KS between variants", seconds_analysis),
@@ -464,7 +466,7 @@ std::string_view to_string(RunKind k) {
 
 SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log,
                              const std::filesystem::path& dir, Collective* group) {
-  check_scene_inputs(s);  // validate(s), and a mesh body's derived quantities, before any file is written
+  check_run(s);  // validate(s), the memory estimate, a mesh body's derived quantities: before any file is written
 #ifdef _OPENMP
   if (s.ensemble.threads > 0) omp_set_num_threads(s.ensemble.threads);  // as run_contact_ensemble does
 #endif

@@ -3,8 +3,10 @@
 // Memory refused up front, not discovered: the peak resident memory of a run estimated from
 // measured costs (per asperity of each contact index, per concurrently built sphere or body, per
 // drop, per bounce sequence), and the memory this process may use.
+#include <stdexcept>
 #include <string>
 
+#include "asperity/app/cor_table.hpp"
 #include "asperity/app/scene.hpp"
 
 namespace asperity {
@@ -17,15 +19,38 @@ struct MemoryEstimate {
 /// The estimated peak RSS of running `s` as validate-geometry does, figures not counted (drawn
 /// in-process by PLplot after the samples: ~17 MB more, measured 32.0 against 15.3 MB for N = 1000,
 /// 2000 drops). Costs measured on x86-64 (docs/cli.md, Memory); within 25 % of the measured peak for
-/// runs whose variable part dominates (tests/app/test_resources.cpp).
+/// runs whose variable part dominates, one test per kind of run (tests/app/test_resources.cpp). A
+/// mesh body's size is read from its file's header (mesh_file_size): nothing is parsed here.
 MemoryEstimate estimate_memory(const Scene& s);
 
-/// The memory this process may use: physical RAM, lowered by a cgroup limit (memory.max) or
-/// RLIMIT_AS when set. 0 when unknown.
+/// The memory this process may use: physical RAM, lowered to what the kernel has available now
+/// (MemAvailable), a cgroup limit (memory.max) or RLIMIT_AS when set. 0 when unknown.
 double memory_limit_bytes();
 
-/// Throws std::invalid_argument naming the values that drive the estimate when it exceeds
+/// A run refused because its estimate exceeds what this process may use (Python: MemoryError).
+struct MemoryRefused : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
+
+/// Throws MemoryRefused naming the values that drive the estimate when it exceeds
 /// memory_limit_bytes(): the run is refused before it starts.
 void check_memory(const Scene& s);
+
+/// Bytes of an explicit sphere of `asperities` centres with a contact index of backend `b`
+/// (brute: the centres alone), as estimate_memory counts them.
+double sphere_bytes(std::uint64_t asperities, Backend b);
+
+/// Bytes of making a restitution table (make_cor_table, one speed's drops at a time) and holding
+/// it with its CSV text; estimate_memory counts it for outputs.cor_table, asperity.cor_table checks it.
+double cor_table_bytes(const CorTableSpec& spec);
+
+/// Throws MemoryRefused when `bytes` exceed memory_limit_bytes(); `what` says what needs them
+/// ("make_rough_sphere: 1000000000 asperities x 24 B"), `lower` the parameters that decide.
+void check_bytes(double bytes, const std::string& what, const std::string& lower);
+
+/// The one check before a run touches anything (validate-geometry, asperity.run, run_scene_output):
+/// validate(s), check_memory(s) -- before any mesh is read --, then check_scene_inputs(s).
+/// Throws MemoryRefused or std::invalid_argument naming the key.
+void check_run(const Scene& s);
 
 }  // namespace asperity

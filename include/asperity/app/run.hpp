@@ -52,7 +52,8 @@ struct SceneOutput {
   std::vector<std::string> skipped;
 };
 
-/// Runs a scene of any kind and renders its report; writes only figures (and the PLY of a mesh
+/// Runs a scene of any kind and renders its report (check_run first: a run that does not fit in
+/// memory is refused before anything is allocated or written, resources.hpp); writes only figures (and the PLY of a mesh
 /// scene's outputs.export_ply), never the report files. Progress of the drops goes to
 /// `progress` (sphere, radii, mesh), one line per bounce variant to `log` if given.
 /// `dir` given (validate-geometry: an OutputStaging's dir()): the files are written there under

@@ -71,8 +71,7 @@ std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& 
     if (scene.plots && share.rank == 0)  // only rank 0 draws
       if (const std::string why = plotting_problem(parse_plot_formats(scene.plot_format)); !why.empty())
         throw BadInput("figures cannot be drawn: " + why + "; or pass --no-plots");
-    check_scene_inputs(scene);
-    check_memory(scene);
+    check_run(scene);  // the same check as run_scene_output's, before the output directory is touched
   } catch (const std::exception& ex) {
     error = ex.what();
     return 2;
