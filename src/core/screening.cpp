@@ -17,6 +17,7 @@
 #include <string>
 #include <tuple>
 
+#include "asperity/core/parallel_errors.hpp"
 #include "asperity/core/random.hpp"
 
 namespace asperity {
@@ -225,8 +226,9 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
   std::vector<std::uint32_t> ncomp(n, 0);
 
   const auto N = static_cast<std::int64_t>(n);
+  LowestIndexError errors;  // an allocation failure must not leave the region (std::terminate)
 #pragma omp parallel for schedule(dynamic, 64)
-  for (std::int64_t jj = 0; jj < N; ++jj) {
+  for (std::int64_t jj = 0; jj < N; ++jj) errors.run(jj, [&] {
     const auto j = static_cast<std::uint32_t>(jj);
     const Vec3& uj = u[j];
     // j can only win at d with 1 - u_j.d <= delta_cov + s_j - s_min (the nearest centre to d is
@@ -247,12 +249,13 @@ ScreeningResult screen_sphere(const RoughBody& b, const SupportQuery& q) {
     const bool won = cap_witness(b, q, comp, j, uj, c);
     if (won) {
       r.status[j] = Screen::witness;
-      continue;
+      return;
     }
     // Helly: the unit ball, the region half-space and every triple of competitors.
     const HalfSpace region{uj, c};
     if (some_triple_misses_ball(&region, 1, comp)) r.status[j] = Screen::screened;
-  }
+  });
+  errors.rethrow();
   tally(r, ncomp);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
@@ -383,8 +386,9 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
   std::vector<std::uint32_t> ncomp(n, 0);
 
   const auto N = static_cast<std::int64_t>(n);
+  LowestIndexError errors;
 #pragma omp parallel for schedule(dynamic, 64)
-  for (std::int64_t jj = 0; jj < N; ++jj) {
+  for (std::int64_t jj = 0; jj < N; ++jj) errors.run(jj, [&] {
     const auto j = static_cast<std::uint32_t>(jj);
     const Vec3& cj = b.centres[j];
     const std::vector<std::uint32_t> nb = local_competitors(b, q, j, all_compete, L0);
@@ -403,7 +407,8 @@ ScreeningResult screen_body(const RoughBody& b, const SupportQuery& q, const Bod
       r.status[j] = Screen::witness;
     else if (helly_certificate(comp, d))
       r.status[j] = Screen::screened;
-  }
+  });
+  errors.rethrow();
   tally(r, ncomp);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -200,14 +200,16 @@ void for_chunks(std::uint64_t total, std::uint64_t offset, std::uint64_t grand_t
                 Body body) {
   const std::int64_t chunks = static_cast<std::int64_t>((total + kChunk - 1) / kChunk);
   std::atomic<std::uint64_t> done{0};
+  LowestIndexError errors;
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t c = 0; c < chunks; ++c) {
-    if (progress.stopped()) continue;
+    if (progress.stopped() || errors.failed()) continue;
     const std::uint64_t b = static_cast<std::uint64_t>(c) * kChunk, e = std::min(total, b + kChunk);
-    body(b, e);
+    errors.run(c, [&] { body(b, e); });
     const std::uint64_t now = done.fetch_add(e - b) + (e - b);
     if (omp_get_thread_num() == 0) progress(offset + now, grand_total);
   }
+  errors.rethrow();
   progress.rethrow();
 }
 
@@ -386,10 +388,11 @@ double many_spheres(const EnsembleConfig& c, const detail::CheckPlan& plan, Guar
   std::atomic<std::uint64_t> done{0};
   double gen = 0, idx = 0, chk = 0;
   std::size_t bytes = 0;
+  LowestIndexError errors;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : gen, idx, chk) reduction(max : bytes)
-  for (std::int64_t kk = 0; kk < spheres; ++kk) {
+  for (std::int64_t kk = 0; kk < spheres; ++kk) errors.run(kk, [&] {
     const auto k = static_cast<std::uint64_t>(kk);
-    if (progress.stopped()) continue;
+    if (progress.stopped() || errors.failed()) return;
     auto t = Clock::now();
     const RoughSphere body = make_rough_sphere(c.sphere, c.seed, k);
     gen += since(t);
@@ -408,7 +411,8 @@ double many_spheres(const EnsembleConfig& c, const detail::CheckPlan& plan, Guar
     }
     const std::uint64_t now = done.fetch_add(m) + m;
     if (omp_get_thread_num() == 0) progress(now, c.drops);
-  }
+  });
+  errors.rethrow();
   progress.rethrow();
   s.seconds_generate = gen, s.seconds_index = idx, s.index_bytes = bytes;
   s.seconds_query = since(t0);  // wall time of the whole loop, generation and indexing included

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "asperity/core/orientation.hpp"
+#include "asperity/core/parallel_errors.hpp"
 #include "asperity/core/random.hpp"
 #include "asperity/laws/theory.hpp"
 #include "experiments/ensemble_detail.hpp"
@@ -219,19 +220,21 @@ void small_sphere_wave(Driver& dr, StreamState& st, std::uint64_t u0, std::uint6
   double gen = 0, idx = 0;
   std::size_t bytes = 0;
   std::vector<detail::SphereCheck> checks(k1 - k0);
+  LowestIndexError errors;
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : gen, idx) reduction(max : bytes)
-  for (std::int64_t kk = std::int64_t(k0); kk < std::int64_t(k1); ++kk) {
+  for (std::int64_t kk = std::int64_t(k0); kk < std::int64_t(k1); ++kk) errors.run(kk, [&] {
     const auto k = static_cast<std::uint64_t>(kk);
     const int t = omp_get_thread_num();
     if (sampled) {
       dr.sampled_unit(k, t, slots[k - k0]);
-      continue;
+      return;
     }
     const Built b = dr.build(k, gen, idx);
     bytes = std::max(bytes, b.index->memory_bytes());
     if (dr.plan.checked(k)) checks[k - k0] = dr.check(b, k);
     for (std::uint64_t j = 0; j < us; ++j) dr.explicit_unit(b, k, j, t, slots[(k - k0) * us + j]);
-  }
+  });
+  errors.rethrow();
   dr.gen += gen, dr.idx += idx, dr.bytes = std::max(dr.bytes, bytes);
   for (const auto& ch : checks) add_check(st, ch, error);
 }
@@ -248,9 +251,11 @@ void big_sphere_wave(Driver& dr, StreamState& st, std::uint64_t u0, std::uint64_
     if (u0 % us == 0 && dr.plan.checked(k)) add_check(st, dr.check(*current, k), error);
   }
   const Built& b = *current;
+  LowestIndexError errors;
 #pragma omp parallel for schedule(dynamic, 1)
   for (std::int64_t u = std::int64_t(u0); u < std::int64_t(u1); ++u)
-    dr.explicit_unit(b, k, std::uint64_t(u) % us, omp_get_thread_num(), slots[std::uint64_t(u) - u0]);
+    errors.run(u, [&] { dr.explicit_unit(b, k, std::uint64_t(u) % us, omp_get_thread_num(), slots[std::uint64_t(u) - u0]); });
+  errors.rethrow();
 }
 
 // Units per sphere and in all: explicit runs K spheres of ceil(m / kUnit) units; sampled runs one
