@@ -8,3 +8,9 @@ work on numpy arrays; asperity.cor_table(...) writes restitution tables for DEM 
 """
 from ._asperity import *  # noqa: F401,F403
 from ._asperity import __version__  # noqa: F401
+
+# Argument errors name the parameter (TypeError for a wrong type, ValueError out of range).
+from . import _asperity as _module  # noqa: E402
+from ._arguments import wrap_module as _wrap_module  # noqa: E402
+
+_wrap_module(globals(), _module, [_module.RoughSphere, _module.ContactQuery, _module.Restitution, _module.Law])

@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <limits>
 #include <filesystem>
 #include <memory>
 #include <sstream>
@@ -20,6 +21,7 @@
 
 #include "asperity/app/cor_table.hpp"
 #include "asperity/app/plan.hpp"
+#include "asperity/app/resources.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene.hpp"
 #include "asperity/app/scene_file.hpp"
@@ -41,8 +43,23 @@ namespace {
 using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
 [[noreturn]] void value_error(const std::string& what) { throw py::value_error(what); }
+// A parameter of the wrong type: TypeError naming it (pybind11's own names no parameter).
+[[noreturn]] void type_error(const std::string& what) { throw py::type_error(what); }
 
 std::string show(const py::handle& h) { return py::repr(h).cast<std::string>(); }
+
+// An array of doubles from `obj`, or TypeError naming the parameter: numpy's own refusal (a string,
+// an object) names nothing. `what` describes what is expected.
+Doubles doubles(const py::handle& obj, const std::string& name, const std::string& what) {
+  if (py::isinstance<py::str>(obj) || py::isinstance<py::bytes>(obj) || obj.is_none())
+    type_error(name + ": expected " + what + ", got " + show(obj));
+  try {
+    return py::cast<Doubles>(obj);
+  } catch (const py::cast_error&) {
+  } catch (const py::error_already_set&) {
+  }
+  type_error(name + ": expected " + what + ", got " + show(obj));
+}
 
 // A std::vector moved into a numpy array without a copy: the capsule owns it.
 template <class T>
@@ -66,12 +83,7 @@ struct Vectors {
 };
 
 Vectors vectors(const py::handle& obj, const char* name) {
-  Doubles a;
-  try {
-    a = py::cast<Doubles>(obj);
-  } catch (const py::cast_error&) {
-    value_error(std::string(name) + ": expected an array of shape (M, 3) or (3,), got " + show(obj));
-  }
+  const Doubles a = doubles(obj, name, "an array of shape (M, 3) or (3,)");
   Vectors out;
   if (a.ndim() == 1 && a.shape(0) == 3) {
     out.single = true;
@@ -115,7 +127,13 @@ py::array_t<double> vectors_to_numpy(const std::vector<Vec3>& v, bool single) {
 template <class Sink>
 bool toml_scalar(const py::handle& h, Sink sink) {
   if (py::isinstance<py::bool_>(h)) return sink(h.cast<bool>()), true;
-  if (py::isinstance<py::int_>(h)) return sink(h.cast<std::int64_t>()), true;
+  if (py::isinstance<py::int_>(h)) {
+    // TOML integers are 64-bit: a larger one is out of every range the scene checks.
+    const auto o = py::reinterpret_borrow<py::int_>(h);
+    if (o < py::int_(std::numeric_limits<std::int64_t>::min()) || o > py::int_(std::numeric_limits<std::int64_t>::max()))
+      return sink(o.cast<double>()), true;
+    return sink(o.cast<std::int64_t>()), true;
+  }
   if (py::isinstance<py::float_>(h)) return sink(h.cast<double>()), true;
   if (py::isinstance<py::str>(h)) return sink(h.cast<std::string>()), true;
   if (py::isinstance<py::dict>(h) || py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h))
@@ -182,7 +200,7 @@ Scene to_scene(const py::handle& scene) {
     for (const auto& p : preset_names()) names += (names.empty() ? "" : ", ") + p;
     value_error("scene: '" + s + "' is neither a scene file nor a preset (" + names + ")");
   }
-  value_error("scene: expected a path, a preset name or a dict, got " + show(scene));
+  type_error("scene: expected a path, a preset name or a dict, got " + show(scene));
 }
 
 // The progress path of every long call: runs with the GIL released; every report takes the GIL,
@@ -200,7 +218,7 @@ Progress python_progress(const py::object& callback) {
 }
 
 void check_callable(const py::object& progress) {
-  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) value_error("progress: expected a callable or None, got " + show(progress));
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) type_error("progress: expected a callable or None, got " + show(progress));
 }
 
 // ---- run ----
@@ -228,10 +246,17 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
   bool arrays = false;
   if (arrays_arg.is_none())
     arrays = run_kind(scene) == RunKind::sphere && scene.ensemble.drops <= max_array_drops;
+  else if (!py::isinstance<py::bool_>(arrays_arg))
+    type_error("arrays: expected None, True or False, got " + show(arrays_arg));
   else if (arrays_arg.cast<bool>()) {
     if (run_kind(scene) != RunKind::sphere)
       value_error("arrays: per-drop arrays exist for sphere scenes only, not for a " + std::string(to_string(run_kind(scene))) + " scene");
     arrays = true;
+  }
+  if (arrays) {  // the arrays' pass keeps every drop: its estimate is the raw run's
+    Scene raw = scene;
+    raw.ensemble.statistics = Statistics::raw;
+    check_memory(raw);
   }
   const Progress p = python_progress(progress);
   SceneOutput out;
@@ -282,12 +307,7 @@ void check_unit(const std::vector<Vec3>& d, const char* name) {
 }
 
 std::vector<Rotation> quaternions(const py::handle& obj, bool& single) {
-  Doubles a;
-  try {
-    a = py::cast<Doubles>(obj);
-  } catch (const py::cast_error&) {
-    value_error("q: expected quaternions (w, x, y, z) of shape (M, 4) or (4,), got " + show(obj));
-  }
+  const Doubles a = doubles(obj, "q", "quaternions (w, x, y, z) of shape (M, 4) or (4,)");
   single = a.ndim() == 1;
   if (!((a.ndim() == 1 && a.shape(0) == 4) || (a.ndim() == 2 && a.shape(1) == 4)))
     value_error("q: expected quaternions (w, x, y, z) of shape (M, 4) or (4,), got an array of " + std::to_string(a.ndim()) + " dimensions");
@@ -313,20 +333,15 @@ std::shared_ptr<Restitution> restitution_model(const py::handle& h) {
     if (!(e >= 0 && e <= 1)) value_error("eps_n = " + show(h) + ": must be in [0, 1]");
     return constant_restitution(e);
   }
-  value_error("eps_n: expected a number in [0, 1] or a restitution model (asperity.pade14, asperity.constant), got " + show(h));
+  type_error("eps_n: expected a number in [0, 1] or a restitution model (asperity.pade14, asperity.constant), got " + show(h));
 }
 
 // Evaluates a scalar function of the library elementwise over an array (GIL released), keeping
 // the input's shape; a Python float in, a float out.
 template <class F>
-py::object elementwise(const py::handle& x, F f) {
+py::object elementwise(const py::handle& x, F f, const char* name = "x") {
   if (py::isinstance<py::float_>(x) || py::isinstance<py::int_>(x)) return py::float_(f(x.cast<double>()));
-  Doubles a;
-  try {
-    a = py::cast<Doubles>(x);
-  } catch (const py::cast_error&) {
-    value_error("x: expected a number or an array of numbers, got " + show(x));
-  }
+  const Doubles a = doubles(x, name, "a number or an array of numbers");
   std::vector<py::ssize_t> shape(a.shape(), a.shape() + a.ndim());
   py::array_t<double> out(shape);
   const double* in = a.data();
@@ -392,6 +407,9 @@ void bind_spheres(py::module_& m) {
             auto q = std::make_shared<PyQuery>();
             q->sphere = self;
             const Backend b = parse_backend(backend);
+            const std::uint64_t n = self->body.centres.size();
+            check_bytes(sphere_bytes(n, b) - sphere_bytes(n, Backend::brute),
+                        "a " + std::string(to_string(b)) + " index over " + std::to_string(n) + " asperities", "the sphere's asperities");
             py::gil_scoped_release nogil;
             q->index = make_contact_query(b, self->body.centres);
             return q;
@@ -403,6 +421,7 @@ void bind_spheres(py::module_& m) {
         SphereParams p;
         p.asperities = n, p.radius = R, p.asperity_radius = a;
         validate(p);
+        check_bytes(sphere_bytes(n, Backend::brute), std::to_string(n) + " asperity centres x 24 B", "asperities");
         auto s = std::make_shared<PySphere>();
         py::gil_scoped_release nogil;
         s->body = make_rough_sphere(p, seed, sphere_id);
@@ -488,7 +507,7 @@ void bind_restitution(py::module_& m) {
             return elementwise(v, [&](double x) {
               if (!(x >= 0) || !std::isfinite(x)) throw std::invalid_argument("v = " + std::to_string(x) + ": speed must be finite and >= 0");
               return (*self)(x);
-            });
+            }, "v");
           },
           py::arg("v"), "eps_n at normal contact speeds v >= 0 [m/s] (a number or an array).");
   m.def(
@@ -520,12 +539,7 @@ void bind_impulse(py::module_& m) {
           if (!(J > 0) || !std::isfinite(J)) value_error("inertia = " + show(inertia) + ": must be finite and > 0");
           body.inertia = J * Eigen::Matrix3d::Identity();
         } else {
-          Doubles a;
-          try {
-            a = py::cast<Doubles>(inertia);
-          } catch (const py::cast_error&) {
-            value_error("inertia: expected a number or a 3x3 array, got " + show(inertia));
-          }
+          const Doubles a = doubles(inertia, "inertia", "a number or a 3x3 array");
           if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3) value_error("inertia: expected a number or a 3x3 array");
           for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) body.inertia(i, j) = a.at(i, j);
@@ -630,21 +644,26 @@ void bind_tables(py::module_& m) {
         try {
           if (!speeds.is_none()) spec.speeds = speeds.cast<std::vector<double>>();
         } catch (const py::cast_error&) {
-          value_error("speeds: expected a sequence of numbers [m/s], got " + show(speeds));
+          type_error("speeds: expected a sequence of numbers [m/s], got " + show(speeds));
         }
         try {
           if (!spins.is_none()) spec.spins = spins.cast<std::vector<double>>();
         } catch (const py::cast_error&) {
-          value_error("spins: expected a sequence of numbers [rad/s], got " + show(spins));
+          type_error("spins: expected a sequence of numbers [rad/s], got " + show(spins));
         }
         spec.omega_bands = omega_bands;
         spec.probabilities = probabilities;
         if (!drops.is_none()) {
-          if (!py::isinstance<py::int_>(drops) || drops.cast<py::int_>() < py::int_(0))
+          if (!py::isinstance<py::int_>(drops) || py::isinstance<py::bool_>(drops)) type_error("drops: expected an integer, got " + show(drops));
+          if (drops.cast<py::int_>() < py::int_(0) || drops.cast<py::int_>() > py::int_(std::uint64_t(-1)))
             value_error("drops = " + show(drops) + ": expected a positive integer");
           spec.drops = drops.cast<std::uint64_t>();
         }
         validate(spec);
+        check_bytes(cor_table_bytes(spec),
+                    std::to_string(spec.drops) + " drops per speed, " + std::to_string(spec.probabilities) + " probabilities x " +
+                        std::to_string(spec.speeds.size()) + " speeds",
+                    "drops, probabilities, speeds, spins or omega_bands");
         const std::string file = path.is_none() ? std::string() : py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
         const Progress p = python_progress(progress);
         CorTable t;
@@ -692,6 +711,15 @@ format-2 table: quantiles then has shape (spins, speeds, p) and omega_band_quant
 }  // namespace
 
 PYBIND11_MODULE(_asperity, m) {
+  // A run refused by the memory estimate is MemoryError with the CLI's message (resources.hpp);
+  // std::bad_alloc is MemoryError and std::invalid_argument ValueError by pybind11's own rules.
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const MemoryRefused& e) {
+      PyErr_SetString(PyExc_MemoryError, e.what());
+    }
+  });
   m.doc() = "asperity: explicit-geometry contacts and restitution of rough particles (C++ library bindings)";
   m.attr("__version__") = ASPERITY_VERSION;
 

@@ -53,7 +53,7 @@ def test_table_progress_and_bad_input():
         small(probabilities=1)
     with pytest.raises(ValueError, match="-5"):
         small(drops=-5)
-    with pytest.raises(ValueError, match="speeds"):
+    with pytest.raises(TypeError, match="speeds"):  # a wrong type (issue 24 item 6)
         small(speeds="fast")
     with pytest.raises(ValueError, match="not a sphere impact scene"):
         small(scene="fig6")

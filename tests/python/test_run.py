@@ -134,15 +134,16 @@ def test_gil_is_released(small_scene):
     ({"format": 1, "ensemble": {"drops": -5}}, "drops"),
     ({"format": 1, "ensemble": {"mode": "sideways"}}, "sideways"),
     ({"format": 1, "bogus": 1}, "bogus"),
-    (42, "42"),
 ])
 def test_bad_scene_raises_value_error_naming_it(scene, needle):
     with pytest.raises(ValueError, match=needle):
         asperity.run(scene)
 
 
-def test_bad_progress_raises_value_error():
-    with pytest.raises(ValueError, match="progress"):
+def test_wrong_types_raise_type_error_naming_them():  # issue 24 item 6; more in test_errors.py
+    with pytest.raises(TypeError, match="scene.*42"):
+        asperity.run(42)
+    with pytest.raises(TypeError, match="progress"):
         asperity.run("fig3", progress=3)
 
 
