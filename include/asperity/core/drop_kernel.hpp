@@ -32,6 +32,7 @@ namespace asperity {
 /// Which instantiation of the drop kernel runs the drops. All give the same bits.
 enum class Kernel { scalar, simd, gpu };
 
+/// "scalar", "simd" or "gpu" (scene key ensemble.kernel, --kernel; parse_kernel reads it back).
 std::string_view to_string(Kernel k);
 /// Parses "scalar", "simd", "gpu"; throws std::invalid_argument naming the value otherwise.
 Kernel parse_kernel(std::string_view name);
@@ -40,8 +41,11 @@ bool kernel_available(Kernel k);
 
 /// One drop's draw: the body-frame down direction and the world azimuth.
 struct DropDraw {
-  Vec3 d;
+  Vec3 d;  ///< unit down direction in the body frame (Marsaglia's disk method)
+  ///@{
+  /// cos and sin of the world azimuth (a normalised disk point): (r_x, r_y) = r_xy (c, s).
   double c = 1, s = 0;
+  ///@}
 };
 
 /// Drops [first, first + n) of `seed` into d, c, s (each of n entries), by kernel k (scalar or

@@ -74,17 +74,22 @@ ASPERITY_HD_INLINE void contact_quantities(D dx, D dy, D dz, D c, D s, D ux, D u
 
 /// The scalar lane operations (CPU reference and CUDA threads).
 struct ScalarLanes {
+  /// The 64-bit product a m as its high and low words (Philox's multiply).
   ASPERITY_HD_INLINE void operator()(std::uint32_t a, std::uint32_t m, std::uint32_t& hi, std::uint32_t& lo) const {
     const std::uint64_t p = static_cast<std::uint64_t>(a) * m;
     hi = static_cast<std::uint32_t>(p >> 32), lo = static_cast<std::uint32_t>(p);
   }
+  /// x as a double (exact: every int32 is a double).
   ASPERITY_HD_INLINE double operator()(std::int32_t x) const { return static_cast<double>(x); }
 };
+/// The scalar square root, correctly rounded on both sides, so that CPU and GPU agree bit for bit.
 struct ScalarSqrt {
   // IEEE sqrt, correctly rounded on the CPU and on CUDA (double sqrt is IEEE there).
 #if defined(__CUDA_ARCH__)
+  /// sqrt(x), IEEE round-to-nearest.
   __device__ __forceinline__ double operator()(double x) const { return __dsqrt_rn(x); }
 #else
+  /// sqrt(x), IEEE round-to-nearest.
   ASPERITY_HD_INLINE double operator()(double x) const { return __builtin_sqrt(x); }
 #endif
 };
