@@ -28,8 +28,12 @@ def run(
     progress: Progress = None,
     arrays: Optional[bool] = None,
     max_array_drops: int = 2000000,
+    out: Union[None, bool, str, "PathLike[str]"] = None,
 ) -> dict[str, Any]:
-    """Runs a scene as validate-geometry does and returns report.json as a dict."""
+    """Runs a scene as validate-geometry does and returns report.json as a dict.
+
+    out: None (default) writes no file; a directory path (or True: the scene's outputs.dir) writes
+    the figures and the scene's output files there."""
 
 class RoughSphere:
     """An explicit rough sphere (core/geometry.hpp)."""

@@ -11,9 +11,11 @@
 #include <toml++/toml.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -240,9 +242,47 @@ py::dict samples_to_dict(ContactSamples&& s) {
   return d;
 }
 
-py::object run(const py::handle& scene_arg, const py::object& progress, const py::object& arrays_arg, std::uint64_t max_array_drops) {
+// A private directory in the system's temporary folder, removed with everything in it when the
+// call ends: where a run that writes no files stages nothing (run_scene_output needs a directory).
+struct PrivateDir {
+  std::filesystem::path path;
+  PrivateDir() {
+    std::string t = (std::filesystem::temp_directory_path() / "asperity-run-XXXXXX").string();
+    if (::mkdtemp(t.data()) == nullptr) throw std::runtime_error("cannot create a temporary directory " + t);
+    path = t;
+  }
+  ~PrivateDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+};
+
+// Where asperity.run may write (out=): None (the default) writes no file at all -- no figures, no
+// checkpoints -- and refuses a scene whose outputs are files (a notebook must not litter its working
+// directory); a path writes the scene's outputs there; True writes them to the scene's outputs.dir.
+// Returns whether files are written.
+bool apply_out(Scene& scene, const py::object& out) {
+  if (out.is_none() || (py::isinstance<py::bool_>(out) && !out.cast<bool>())) {
+    const char* file_output = scene.cor_table ? "outputs.cor_table" : scene.mesh && !scene.mesh->export_ply.empty() ? "body.export_ply" : nullptr;
+    if (file_output)
+      value_error(std::string("out: the scene's ") + file_output + " writes a file; pass out=DIR (or out=True for the scene's outputs.dir)");
+    scene.plots = false;
+    scene.checkpoint_seconds = 0;  // no signal handler in Python: never written
+    return false;
+  }
+  if (py::isinstance<py::bool_>(out)) return true;  // True: the scene's outputs.dir
+  if (!py::isinstance<py::str>(out) && !py::hasattr(out, "__fspath__"))
+    type_error("out: expected None, True, False or a directory path, got " + show(out));
+  scene.out = py::str(py::module_::import("os").attr("fspath")(out)).cast<std::string>();
+  if (scene.out.empty()) value_error("out: '' is not a directory name");
+  return true;
+}
+
+py::object run(const py::handle& scene_arg, const py::object& progress, const py::object& arrays_arg, std::uint64_t max_array_drops,
+               const py::object& out_arg) {
   check_callable(progress);
-  const Scene scene = to_scene(scene_arg);
+  Scene scene = to_scene(scene_arg);
+  const bool files = apply_out(scene, out_arg);
   bool arrays = false;
   if (arrays_arg.is_none())
     arrays = run_kind(scene) == RunKind::sphere && scene.ensemble.drops <= max_array_drops;
@@ -261,9 +301,11 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
   const Progress p = python_progress(progress);
   SceneOutput out;
   ContactSamples samples;
+  std::optional<PrivateDir> scratch;
+  if (!files) scratch.emplace();
   {
     py::gil_scoped_release nogil;
-    out = run_scene_output(scene, p);
+    out = run_scene_output(scene, p, nullptr, files ? std::filesystem::path() : scratch->path);
     // The same drops again, bit-identical (every drop is a pure function of seed and index), kept.
     if (arrays) samples = run_contact_ensemble(make_plan(scene).scene.ensemble, p);
   }
@@ -369,7 +411,7 @@ void bind_scenes_and_runs(py::module_& m) {
   m.def("scene_toml", [](const py::handle& scene) { return to_toml(to_scene(scene)); }, py::arg("scene"),
         "The effective scene (path, preset name or dict) as a format-1 TOML document.");
   m.def("run", &run, py::arg("scene"), py::arg("progress") = py::none(), py::arg("arrays") = py::none(),
-        py::arg("max_array_drops") = std::uint64_t{2000000},
+        py::arg("max_array_drops") = std::uint64_t{2000000}, py::arg("out") = py::none(),
         R"doc(Runs a scene as validate-geometry does and returns report.json as a dict.
 
 scene: a scene file path, a preset name (asperity.presets()) or a dict in the scene-file layout.
@@ -378,8 +420,11 @@ arrays: None (default) adds report["arrays"] (per-drop numpy arrays r_x, r_y, r_
   core, and for impacts eps, omega_x_after, eps_n, eps_core) for sphere scenes of at most
   max_array_drops drops; True/False forces. The arrays are the run's drops recomputed from the
   same seed (bit-identical), which costs a second pass over the ensemble.
-The GIL is released while the run computes; Ctrl-C raises KeyboardInterrupt. Figures and files
-of the scene's outputs are written as by the CLI; the report file is not.)doc");
+out: None (default) writes no file at all (no figures, no checkpoints; a scene whose outputs are
+  files -- outputs.cor_table, body.export_ply -- is refused); a directory path writes the figures and
+  the scene's output files there, as the CLI would (the report file is not written: it is the
+  return value); True writes them to the scene's outputs.dir.
+The GIL is released while the run computes; Ctrl-C raises KeyboardInterrupt.)doc");
 }
 
 void bind_spheres(py::module_& m) {
