@@ -40,6 +40,9 @@ const std::vector<double> kProbs{0.01, 0.05, 0.25, 0.5, 0.75, 0.95, 0.99};
 // (groups of whole spheres beyond that: a replicate costs O(blocks x grid)).
 constexpr std::size_t kKsGrid = 1024;
 constexpr std::size_t kMaxBlocks = 256;
+// A rejected law's bootstrap p is resolved to alpha/(5 x 10): Holm's smallest threshold is alpha/m,
+// and a run has at most 8 decisive bootstrap and LR tests (r_xy, r_x, r_y, eps, Omega'_x).
+constexpr double kFamilyResolve = 10;
 
 std::vector<double> sorted(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -442,7 +445,9 @@ void test_explicit(GeometryReport& r, const TestContext& c, const LawSet& set, s
   std::vector<BlockKsResult> res;
   try {
     if (c.v.decisive && x.size() == c.v.n) {
-      res = block_ks_tests(bins, cdfs, c.scene.alpha, c.scene.ensemble.seed, stream);
+      std::vector<double> resolve;  // decisive laws: fine enough for Holm; printed laws as before
+      for (const auto& [li, cdf] : laws) resolve.push_back(set.decisive[li] ? c.scene.alpha / kFamilyResolve : c.scene.alpha);
+      res = block_ks_tests(bins, cdfs, c.scene.alpha, c.scene.ensemble.seed, stream, 199, 9999, resolve);
     } else {
       for (const auto& f : cdfs) res.push_back({binned_ks_distance(bins, f), kNaN, 0, Verdict::not_decisive});
     }
