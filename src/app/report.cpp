@@ -730,13 +730,13 @@ std::string family_json(const FamilyDecision& f, const std::vector<std::string>&
       adjusted[key] = f.adjusted_p[i];
     }
   const json j = {{"procedure", "holm"},
-          {"alpha", f.alpha},
-          {"tests", f.tests},
-          {"rejected", f.rejected},
-          {"min_adjusted_p", std::isnan(f.min_adjusted_p) ? json(nullptr) : json(f.min_adjusted_p)},
-          {"adjusted_p", adjusted},
-          {"members", "decisive tests with verdict accept or reject (not-decisive, skipped and undecided ones are "
-                      "not in the family); valid under any dependence between them"}};
+                  {"alpha", f.alpha},
+                  {"tests", f.tests},
+                  {"rejected", f.rejected},
+                  {"min_adjusted_p", std::isnan(f.min_adjusted_p) ? json(nullptr) : json(f.min_adjusted_p)},
+                  {"adjusted_p", adjusted},
+                  {"members", "decisive tests with verdict accept or reject (not-decisive, skipped and undecided "
+                              "ones are not in the family); valid under any dependence between them"}};
   return j.dump();
 }
 
