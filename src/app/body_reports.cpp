@@ -54,7 +54,9 @@ void write_tests(std::ostream& os, const std::vector<LawCheck>& tests, const cha
   }
   const FamilyDecision f = check_family(tests, alpha);
   os << "family (Holm, " << f.tests << " decided decisive test" << (f.tests == 1 ? "" : "s") << ", alpha = " << alpha
-     << "): " << (f.rejected ? "REJECT" : "accept") << ", smallest adjusted p = " << f.min_adjusted_p << "\n";
+     << "): " << (f.rejected ? "REJECT" : "accept");
+  if (f.tests > 0) os << ", smallest adjusted p = " << f.min_adjusted_p;
+  os << "\n";
   for (const auto& t : tests)
     if (t.verdict == Verdict::skipped)
       os << "skipped: " << t.quantity << " " << t.law << (t.decisive ? " (decisive)" : "") << ": " << t.note << "\n";
