@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -15,25 +16,33 @@ namespace asperity {
 namespace {
 
 nlohmann::json json_of(const Estimate& e) { return {{"value", e.value}, {"se", e.se}}; }
-nlohmann::json json_of(const LawCheck& c) {
+nlohmann::json json_of(const LawCheck& c, double adjusted_p, bool family_reject) {
   return {{"quantity", c.quantity}, {"law", c.law},     {"lambda", c.lambda},           {"statistic", "KS"},
           {"D", c.ks.D},            {"p", c.ks.p},       {"n", c.ks.n},                  {"power_check", c.power_check},
-          {"decisive", c.decisive}, {"verdict", to_string(c.verdict)},   {"note", c.note}};
+          {"decisive", c.decisive}, {"verdict", to_string(c.verdict)},   {"note", c.note},
+          {"adjusted_p", std::isnan(adjusted_p) ? nlohmann::json(nullptr) : nlohmann::json(adjusted_p)},
+          {"family_reject", family_reject}};
 }
 
-// tests[], plots, rejected, skipped of a report body.
-void add_tests(nlohmann::json& j, const std::vector<LawCheck>& tests, const std::vector<std::string>& plots) {
+// tests[], plots, rejected (the family's decision, Holm at alpha), family, skipped of a report body.
+void add_tests(nlohmann::json& j, const std::vector<LawCheck>& tests, const std::vector<std::string>& plots, double alpha) {
+  const FamilyDecision family = check_family(tests, alpha);
+  std::vector<std::string> names;
   j["tests"] = nlohmann::json::array();
-  for (const auto& t : tests) j["tests"].push_back(json_of(t));
+  for (std::size_t i = 0; i < tests.size(); ++i) {
+    j["tests"].push_back(json_of(tests[i], family.adjusted_p[i], family.reject[i]));
+    names.push_back(tests[i].quantity + " " + tests[i].law + " (KS)");
+  }
   j["plots"] = image_files(plots);
   j["plot_data"] = data_files(plots);
-  j["rejected"] = decisive_rejection(tests);
+  j["rejected"] = family.rejected;
+  j["family"] = nlohmann::json::parse(family_json(family, names));
   j["skipped"] = decisive_skipped(tests);
 }
 
 // The tests as table rows (the lambda column if asked), then why any test was skipped.
 void write_tests(std::ostream& os, const std::vector<LawCheck>& tests, const char* quantity_label, int qw, int lw,
-                 bool lambda) {
+                 bool lambda, double alpha) {
   os << std::left << std::setw(qw) << quantity_label << std::setw(lw) << "law";
   if (lambda) os << std::setw(13) << "lambda";
   os << std::setw(11) << "KS D" << std::setw(11) << "p" << "verdict\n";
@@ -43,6 +52,11 @@ void write_tests(std::ostream& os, const std::vector<LawCheck>& tests, const cha
     os << std::setw(11) << t.ks.D << std::setw(11) << t.ks.p << to_string(t.verdict)
        << (t.power_check ? " (power check: must reject)" : "") << "\n";
   }
+  const FamilyDecision f = check_family(tests, alpha);
+  os << "family (Holm, " << f.tests << " decided decisive test" << (f.tests == 1 ? "" : "s") << ", alpha = " << alpha
+     << "): " << (f.rejected ? "REJECT" : "accept");
+  if (f.tests > 0) os << ", smallest adjusted p = " << f.min_adjusted_p;
+  os << "\n";
   for (const auto& t : tests)
     if (t.verdict == Verdict::skipped)
       os << "skipped: " << t.quantity << " " << t.law << (t.decisive ? " (decisive)" : "") << ": " << t.note << "\n";
@@ -70,7 +84,7 @@ std::string format_table(const RadiiReport& r) {
     for (double f : r.winner_level_fraction) os << " " << f;
   }
   os << ", core contacts " << r.core_contacts << ", std(r_x) = " << r.rx_std.value << " +- " << r.rx_std.se << " m\n";
-  write_tests(os, r.tests, "qty", 6, 24, true);
+  write_tests(os, r.tests, "qty", 6, 24, true, e.alpha);
   return detail::checked_text(std::move(os), "report.txt");
 }
 
@@ -98,7 +112,7 @@ std::string to_json(const RadiiReport& r) {
   j["winner_level_fraction"] = r.winner_level_fraction;
   j["core_contacts"] = r.core_contacts;
   j["rx_std"] = json_of(r.rx_std);
-  add_tests(j, r.tests, r.plots);
+  add_tests(j, r.tests, r.plots, e.alpha);
   j["seconds_fresh"] = r.seconds_fresh;
   return j.dump(2) + "\n";
 }
@@ -133,7 +147,7 @@ std::string format_table(const MeshImpactReport& r) {
     for (const auto& x : q.summary.quantiles) os << x.value << " ";
     os << "\n";
   }
-  write_tests(os, r.tests, "quantity", 15, 28, false);
+  write_tests(os, r.tests, "quantity", 15, 28, false, e.alpha);
   return detail::checked_text(std::move(os), "report.txt");
 }
 
@@ -171,7 +185,7 @@ std::string to_json(const MeshImpactReport& r) {
                                {"mean", json_of(q.summary.mean)},
                                {"std", json_of(q.summary.std)},
                                {"batches", q.summary.batches}});
-  add_tests(j, r.tests, r.plots);
+  add_tests(j, r.tests, r.plots, e.alpha);
   j["seconds"] = r.seconds;
   if (const auto& s = r.screening; s.bodies > 0)
     j["screening"] = {{"bodies", s.bodies},

@@ -22,7 +22,9 @@
 #include "asperity/app/plot.hpp"
 #include "asperity/config.hpp"
 #include "asperity/core/random.hpp"
+#include "asperity/laws/atom.hpp"
 #include "asperity/laws/block_ks.hpp"
+#include "asperity/laws/family.hpp"
 #include "asperity/laws/theory.hpp"
 #include "asperity/laws/theory_impact.hpp"
 
@@ -31,12 +33,16 @@ namespace asperity {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 const std::vector<double> kProbs{0.01, 0.05, 0.25, 0.5, 0.75, 0.95, 0.99};
 // The grid of the explicit design's binned KS statistic (points at pooled-sample quantiles: the
 // binned D is at most ~1/kKsGrid below the full one) and the most blocks its bootstrap resamples
 // (groups of whole spheres beyond that: a replicate costs O(blocks x grid)).
 constexpr std::size_t kKsGrid = 1024;
 constexpr std::size_t kMaxBlocks = 256;
+// A rejected law's bootstrap p is resolved to alpha/(5 x 10): Holm's smallest threshold is alpha/m,
+// and a run has at most 8 decisive bootstrap and LR tests (r_xy, r_x, r_y, eps, Omega'_x).
+constexpr double kFamilyResolve = 10;
 
 std::vector<double> sorted(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -193,9 +199,11 @@ nlohmann::json timings_json(const std::vector<std::pair<std::string, double>>& t
 
 }  // namespace
 
-bool GeometryReport::rejected() const {
-  return std::any_of(tests.begin(), tests.end(), [](const TestReport& t) { return rejects(t); });
+FamilyDecision GeometryReport::family() const {
+  return family_decision(tests, [](const TestReport& t) { return t.p; }, scene.alpha);
 }
+
+bool GeometryReport::rejected() const { return family().rejected; }
 
 std::size_t GeometryReport::skipped() const {
   return static_cast<std::size_t>(std::count_if(tests.begin(), tests.end(), [](const TestReport& t) { return unresolved(t); }));
@@ -386,18 +394,49 @@ TestReport explicit_test(const TestContext& c, const LawSet& set, std::size_t li
   return t;
 }
 
+bool any_atom(const LawSet& set) {
+  return std::any_of(set.has_atom.begin(), set.has_atom.end(), [](bool b) { return b; });
+}
+
+// The sample of a set. Core contacts sit exactly at the atom of the corrected laws (eps = eps_n,
+// Omega'_x = Omega_x up to rounding): snapped there so that the empirical cdf and the law's cdf
+// step at the same point.
+std::vector<double> snapped_column(const TestContext& c, const LawSet& set) {
+  const auto& x0 = column(c.s, set.quantity);
+  std::vector<double> x(x0.begin(), x0.end());
+  if (any_atom(set) && c.s.eps_core.size() == x.size())
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (c.s.eps_core[i]) x[i] = set.atom;
+  return x;
+}
+
+// A sample without spread, or a law that is an atom, is compared exactly (laws/atom.hpp): the KS
+// and bootstrap tests have no null distribution there (every D* = 0 puts any D > 0 at the floor p).
+// Overrides the row's statistic, D, p and verdict; `units`: independent units (drops or spheres).
+void decide_degenerate(TestReport& t, const LawSet& set, std::size_t li, const std::vector<double>& x,
+                       std::size_t units, double alpha) {
+  const bool atom = li < set.has_atom.size() && set.has_atom[li];
+  std::optional<AtomTest> a;
+  try {
+    a = exact_atom_test(x, set.laws[li].cdf, units, atom ? std::optional<double>(set.atom) : std::nullopt);
+  } catch (const std::exception&) {
+    return;  // the law cannot be evaluated there: the ordinary test's row stands
+  }
+  if (!a) return;
+  t.note = a->note + " (" + t.statistic + " not used)";
+  t.statistic = "exact-atom";
+  t.D = a->D, t.p = a->p;
+  t.verdict = verdict_at(a->p, alpha);
+}
+
 // Explicit design: the binned KS distance of all drops against each law; p from the sphere-block
 // bootstrap when the design can decide. `stream` (the set's index) keeps the replicates apart.
 void test_explicit(GeometryReport& r, const TestContext& c, const LawSet& set, std::size_t stream) {
-  const auto& x0 = column(c.s, set.quantity);
-  const bool any_atom = std::any_of(set.has_atom.begin(), set.has_atom.end(), [](bool b) { return b; });
-  // Core contacts sit exactly at the atom of the corrected laws (eps = eps_n, Omega'_x = Omega_x up to
-  // rounding): snap them so that the empirical cdf and the law's cdf step at the same point.
-  std::vector<double> x(x0.begin(), x0.end());
-  if (any_atom && c.s.eps_core.size() == x.size())
-    for (std::size_t i = 0; i < x.size(); ++i)
-      if (c.s.eps_core[i]) x[i] = set.atom;
-  const std::vector<double> extra = any_atom ? std::vector<double>{set.atom} : std::vector<double>{};
+  const std::vector<double> x = snapped_column(c, set);
+  // The atom and the point just below it are grid edges: drops at the atom and drops just off it
+  // (eps < eps_n) fall in different cells even when every pooled quantile is the atom.
+  const std::vector<double> extra =
+      any_atom(set) ? std::vector<double>{std::nextafter(set.atom, -kInf), set.atom} : std::vector<double>{};
   const auto laws = evaluable_laws(r, c, set, x);
   if (laws.empty()) return;
   std::vector<Cdf> cdfs;
@@ -406,7 +445,9 @@ void test_explicit(GeometryReport& r, const TestContext& c, const LawSet& set, s
   std::vector<BlockKsResult> res;
   try {
     if (c.v.decisive && x.size() == c.v.n) {
-      res = block_ks_tests(bins, cdfs, c.scene.alpha, c.scene.ensemble.seed, stream);
+      std::vector<double> resolve;  // decisive laws: fine enough for Holm; printed laws as before
+      for (const auto& [li, cdf] : laws) resolve.push_back(set.decisive[li] ? c.scene.alpha / kFamilyResolve : c.scene.alpha);
+      res = block_ks_tests(bins, cdfs, c.scene.alpha, c.scene.ensemble.seed, stream, 199, 9999, resolve);
     } else {
       for (const auto& f : cdfs) res.push_back({binned_ks_distance(bins, f), kNaN, 0, Verdict::not_decisive});
     }
@@ -416,13 +457,18 @@ void test_explicit(GeometryReport& r, const TestContext& c, const LawSet& set, s
                                      std::string("cannot be evaluated at these parameters: ") + ex.what()));
     return;
   }
-  for (std::size_t j = 0; j < laws.size(); ++j) r.tests.push_back(explicit_test(c, set, laws[j].first, res[j], bins, x.size()));
+  for (std::size_t j = 0; j < laws.size(); ++j) {
+    r.tests.push_back(explicit_test(c, set, laws[j].first, res[j], bins, x.size()));
+    if (res[j].verdict != Verdict::not_decisive)
+      decide_degenerate(r.tests.back(), set, laws[j].first, x, c.v.K, c.scene.alpha);
+  }
 }
 
 // Sampled design: iid drops, the exact one-sample KS test (randomised PIT at a law's atom).
 void test_sampled(GeometryReport& r, const TestContext& c, const LawSet& set) {
   const auto& x0 = column(c.s, set.quantity);
   const auto all = sorted(x0);
+  const std::vector<double> x = snapped_column(c, set);
   for (std::size_t li = 0; li < set.laws.size(); ++li) {
     const Law& law = set.laws[li];
     const bool decisive_law = set.decisive[li];
@@ -446,6 +492,7 @@ void test_sampled(GeometryReport& r, const TestContext& c, const LawSet& set) {
     if (atom) t.note = "includes core contacts as an atom of mass " + fmt(set.atom_mass, 3) + " (randomised PIT)";
     t.D = ks.D, t.p = ks.p;
     t.verdict = ks.p < c.scene.alpha ? Verdict::reject : Verdict::accept;
+    decide_degenerate(t, set, li, x, x.size(), c.scene.alpha);
     r.tests.push_back(t);
   }
 }
@@ -515,6 +562,21 @@ std::string design_label(const GeometryReport& r) {
   const auto& d = r.design;
   return design_label(d.kind, d.spheres, d.rotations_per_sphere, d.backend);
 }
+
+// What the verdict line adds: the family, its level and its smallest adjusted p, and the decisive
+// tests below alpha on their own that the family does not reject.
+std::string family_line(const std::vector<TestReport>& tests, const FamilyDecision& f) {
+  std::ostringstream os;
+  os << " by the family of " << f.tests << " decided decisive test" << (f.tests == 1 ? "" : "s")
+     << " (Holm, alpha = " << f.alpha << ", smallest adjusted p = " << fmt(f.min_adjusted_p, 3) << ")";
+  std::size_t alone = 0;
+  for (std::size_t i = 0; i < tests.size(); ++i) alone += rejects(tests[i]) && !f.reject[i];
+  if (alone > 0)
+    os << "; " << alone << " decisive test" << (alone == 1 ? "" : "s")
+       << " below alpha on its own, not rejected by the family";
+  return os.str();
+}
+
 }  // namespace
 
 std::string format_table(const GeometryReport& r) {
@@ -528,9 +590,11 @@ std::string format_table(const GeometryReport& r) {
      << r.scene.alpha << " per test\n\n";
   os << std::left << std::setw(14) << "quantity" << std::setw(24) << "measured mean +- se" << std::setw(18) << "law"
      << std::setw(12) << "law mean" << std::setw(21) << "test" << std::setw(10) << "KS D" << std::setw(11) << "p"
-     << "verdict\n";
-  os << std::string(117, '-') << "\n";
-  for (const auto& t : r.tests) {
+     << std::setw(11) << "Holm p" << std::setw(8) << "family" << "verdict\n";
+  os << std::string(136, '-') << "\n";
+  const FamilyDecision family = r.family();
+  for (std::size_t i = 0; i < r.tests.size(); ++i) {
+    const auto& t = r.tests[i];
     std::string measured = "-";
     const double scale = display_scale(t.quantity);
     if (t.quantity == "core_contacts") {
@@ -545,7 +609,8 @@ std::string format_table(const GeometryReport& r) {
     if (!t.decisive) verdict += " (info)";
     os << std::left << std::setw(14) << t.quantity << std::setw(24) << measured << std::setw(18) << t.law
        << std::setw(12) << fmt(t.predicted_mean * scale, t.quantity == "eps" ? 8 : 5) << std::setw(21) << t.statistic << std::setw(10) << fmt(t.D, 3)
-       << std::setw(11) << fmt(t.p, 3) << verdict << "\n";
+       << std::setw(11) << fmt(t.p, 3) << std::setw(11) << fmt(family.adjusted_p[i], 3) << std::setw(8)
+       << (std::isnan(family.adjusted_p[i]) ? "-" : family.reject[i] ? "reject" : "accept") << verdict << "\n";
   }
   os << "\ncore contacts: " << r.core_contacts << " of " << r.samples << " drops (expected "
      << fmt(r.core_probability * double(r.samples), 4) << "; paper's estimate per drop " << fmt(r.core_probability_paper, 3)
@@ -573,7 +638,7 @@ std::string format_table(const GeometryReport& r) {
        << fmt(d.quenched_scale, 3) << ", model error (Eq. 14 vs exact finite-N law) " << fmt(d.model_error_scale, 3) << "\n";
   }
   os << r.ensemble_note << "\n";
-  os << "verdict: " << (r.rejected() ? "a law was REJECTED" : "no law rejected");
+  os << "verdict: " << (family.rejected ? "a law was REJECTED" : "no law rejected") << family_line(r.tests, family);
   if (const std::size_t k = r.skipped(); k > 0)
     os << "; " << k << " decisive test" << (k == 1 ? "" : "s")
        << " SKIPPED or UNDECIDED (could not be evaluated or decided, see the notes)";
@@ -629,10 +694,12 @@ nlohmann::json quantities_json(const std::vector<QuantityReport>& quantities) {
   return q;
 }
 
-nlohmann::json tests_json(const std::vector<TestReport>& rows) {
+nlohmann::json tests_json(const std::vector<TestReport>& rows, const FamilyDecision& family) {
   using nlohmann::json;
   json tests = json::array();
-  for (const auto& t : rows) {
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& t = rows[i];
+    const double adj = family.adjusted_p[i];
     tests.push_back({{"quantity", t.quantity},
                      {"law", t.law},
                      {"scope", t.scope},
@@ -644,9 +711,41 @@ nlohmann::json tests_json(const std::vector<TestReport>& rows) {
                      {"iid", t.iid},
                      {"decisive", t.decisive},
                      {"verdict", std::string(to_string(t.verdict))},
-                     {"note", t.note}});
+                     {"note", t.note},
+                     {"adjusted_p", std::isnan(adj) ? json(nullptr) : json(adj)},
+                     {"family_reject", bool(family.reject[i])}});
   }
   return tests;
+}
+
+}  // namespace
+
+std::string family_json(const FamilyDecision& f, const std::vector<std::string>& names) {
+  using nlohmann::json;
+  json adjusted = json::object();
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (!std::isnan(f.adjusted_p[i])) {
+      std::string key = names[i];
+      for (int k = 2; adjusted.contains(key); ++k) key = names[i] + " #" + std::to_string(k);
+      adjusted[key] = f.adjusted_p[i];
+    }
+  const json j = {{"procedure", "holm"},
+                  {"alpha", f.alpha},
+                  {"tests", f.tests},
+                  {"rejected", f.rejected},
+                  {"min_adjusted_p", std::isnan(f.min_adjusted_p) ? json(nullptr) : json(f.min_adjusted_p)},
+                  {"adjusted_p", adjusted},
+                  {"members", "decisive tests with verdict accept or reject (not-decisive, skipped and undecided "
+                              "ones are not in the family); valid under any dependence between them"}};
+  return j.dump();
+}
+
+namespace {
+
+std::vector<std::string> test_names(const std::vector<TestReport>& rows) {
+  std::vector<std::string> names;
+  for (const auto& t : rows) names.push_back(t.quantity + " " + t.law + " (" + t.statistic + ")");
+  return names;
 }
 
 }  // namespace
@@ -688,8 +787,10 @@ std::string to_json(const GeometryReport& r) {
                         {"backends", r.cross_check.backends}};
   j["runner_up_gap_m"] = {{"min", r.gap_min}, {"median", r.gap_median}};
   j["quantities"] = quantities_json(r.quantities);
-  j["tests"] = tests_json(r.tests);
-  j["rejected"] = r.rejected();
+  const FamilyDecision family = r.family();
+  j["tests"] = tests_json(r.tests, family);
+  j["rejected"] = family.rejected;  // the family's decision (Holm), the exit status
+  j["family"] = json::parse(family_json(family, test_names(r.tests)));
   j["skipped"] = r.skipped();
   j["timings_s"] = timings_json(r.timings_s);
   if (r.index_bytes) j["index_bytes_per_asperity"] = double(r.index_bytes) / double(e.sphere.asperities);

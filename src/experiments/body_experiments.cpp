@@ -106,18 +106,17 @@ struct ScreeningPool {
 
 }  // namespace
 
-bool decisive_rejection(const std::vector<LawCheck>& tests) {
-  for (const auto& t : tests)
-    if (rejects(t)) return true;
-  return false;
+FamilyDecision check_family(const std::vector<LawCheck>& tests, double alpha) {
+  return family_decision(tests, [](const LawCheck& t) { return t.ks.p; }, alpha);
 }
+bool decisive_rejection(const std::vector<LawCheck>& tests, double alpha) { return check_family(tests, alpha).rejected; }
 std::size_t decisive_skipped(const std::vector<LawCheck>& tests) {
   return static_cast<std::size_t>(
       std::count_if(tests.begin(), tests.end(), [](const LawCheck& t) { return unresolved(t); }));
 }
-bool RadiiReport::rejected() const { return decisive_rejection(tests); }
+bool RadiiReport::rejected() const { return decisive_rejection(tests, experiment.alpha); }
 
-bool MeshImpactReport::rejected() const { return decisive_rejection(tests); }
+bool MeshImpactReport::rejected() const { return decisive_rejection(tests, experiment.alpha); }
 
 void validate(const RadiiExperiment& e) {
   check_asperity_count(e.asperities);

@@ -131,13 +131,18 @@ void block_bootstrap_ks(const BlockBins& b, std::uint64_t seed, std::uint64_t st
 }
 
 std::vector<BlockKsResult> block_ks_tests(const BlockBins& b, std::span<const Cdf> laws, double alpha, std::uint64_t seed,
-                                          std::uint64_t stream, std::size_t min_replicates, std::size_t max_replicates) {
+                                          std::uint64_t stream, std::size_t min_replicates, std::size_t max_replicates,
+                                          std::span<const double> resolve) {
   if (!(alpha > 0 && alpha < 1)) throw std::invalid_argument("block_ks_tests: alpha must be in (0, 1)");
+  if (!resolve.empty() && resolve.size() != laws.size())
+    throw std::invalid_argument("block_ks_tests: one resolve level per law, or none");
+  for (double r : resolve)
+    if (!(r > 0 && r <= alpha)) throw std::invalid_argument("block_ks_tests: resolve must be in (0, alpha]");
   std::vector<BlockKsResult> res(laws.size());
   for (std::size_t i = 0; i < laws.size(); ++i) res[i].D = binned_ks_distance(b, laws[i]);
   std::vector<double> dstar;
   // Rounds of replicates: B + 1 = 200, 1000, 5000, 10000 (then max_replicates). A law is decided early when
-  // its p is clearly above (c/B > 5 alpha) or below ((1 + c)/(B + 1) <= alpha/5) the level.
+  // its p is clearly above (c/B > 5 alpha) or below ((1 + c)/(B + 1) <= resolve/5) the level.
   std::vector<std::size_t> rounds;
   for (std::size_t B : {min_replicates, std::size_t{999}, std::size_t{4999}, std::size_t{9999}, max_replicates})
     if (B >= min_replicates && B <= max_replicates && (rounds.empty() || B > rounds.back())) rounds.push_back(B);
@@ -145,11 +150,13 @@ std::vector<BlockKsResult> block_ks_tests(const BlockBins& b, std::span<const Cd
     const std::size_t B = rounds[round];
     block_bootstrap_ks(b, seed, stream, dstar.size(), B - dstar.size(), dstar);
     bool all_decided = true;
-    for (auto& r : res) {
+    for (std::size_t i = 0; i < res.size(); ++i) {
+      auto& r = res[i];
+      const double level = resolve.empty() ? alpha : resolve[i];
       const auto c = static_cast<std::size_t>(std::count_if(dstar.begin(), dstar.end(), [&](double d) { return d >= r.D; }));
       r.replicates = B;
       r.p = double(1 + c) / double(B + 1);
-      const bool clear = double(c) / double(B) > 5 * alpha || r.p <= alpha / 5;
+      const bool clear = double(c) / double(B) > 5 * alpha || r.p <= level / 5;
       if (!clear) all_decided = false;
     }
     if (all_decided) break;

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <string>
 
@@ -120,6 +121,23 @@ TEST(Cli, GoodRunWritesTheReportContract) {
     laws.insert(t.at("law").get<std::string>());
   }
   EXPECT_TRUE(laws.count("eq14") && laws.count("eq18") && laws.count("exact-sphere"));
+  // The run-level decision: Holm over the decided decisive tests; `rejected` is its decision.
+  const auto& fam = j.at("family");
+  EXPECT_EQ(fam.at("procedure"), "holm");
+  EXPECT_EQ(fam.at("alpha"), j.at("parameters").at("alpha"));
+  EXPECT_EQ(fam.at("rejected"), j.at("rejected"));
+  std::size_t members = 0;
+  for (const auto& t : j.at("tests")) {
+    EXPECT_TRUE(t.at("family_reject").is_boolean());
+    members += !t.at("adjusted_p").is_null();
+    if (!t.at("adjusted_p").is_null()) {
+      EXPECT_GE(t.at("adjusted_p").get<double>(), t.at("p").get<double>());
+    }
+  }
+  EXPECT_EQ(fam.at("tests"), members);
+  EXPECT_EQ(fam.at("adjusted_p").size(), members);
+  EXPECT_EQ(members, 6u);  // r_xy, r_x, r_y against Eq. 14/18 and the exact law
+  EXPECT_NE(r.out.find("(Holm, alpha = 0.01, smallest adjusted p = "), std::string::npos) << r.out;
   for (const char* k : {"generate", "index", "query", "analysis"}) EXPECT_TRUE(j.at("timings_s").contains(k)) << k;
   // No temporary files are left next to the report and its table.
   for (const auto& e : fs::directory_iterator(out))
@@ -157,6 +175,30 @@ TEST(Cli, ScalarAndSimdKernelsOnOneAndTwoThreadsWriteTheSameReport) {
     fs::remove_all(a);
     fs::remove_all(b);
   }
+}
+
+TEST(Cli, ADegenerateSampleIsComparedExactlyNotAtTheBootstrapFloor) {
+  // Every drop is a core contact (R = 1e6 m): Omega'_x = Omega_x for every drop and eq33-corrected
+  // puts all but 5e-7 of its mass there. The sphere-block bootstrap put p at its floor 0.001 (every
+  // D* = 0) and the run exited 1; the exact comparison accepts (p = 1) and rejects the printed
+  // Eq. 33, whose mass is elsewhere (p = 0: the wrong atom). Exit 0 (eq28-corrected cannot be
+  // evaluated at R = 1e6 m: skipped, a warning).
+  const fs::path out = fresh_dir("atom");
+  const CliRun r = run("--preset fig4 --radius 1e6 --asperity-radius 1e-3 --asperities 1000 --drops 2000 --no-plots --out " +
+                       out.string());
+  EXPECT_EQ(r.status, 0) << r.out;
+  std::ifstream f(out / "report.json");
+  const auto j = nlohmann::json::parse(f);
+  EXPECT_EQ(j.at("rejected"), false);
+  std::map<std::string, nlohmann::json> rows;
+  for (const auto& t : j.at("tests"))
+    if (t.at("quantity") == "omega_x_after") rows[t.at("law").get<std::string>()] = t;
+  EXPECT_EQ(rows.at("eq33-corrected").at("statistic"), "exact-atom");
+  EXPECT_EQ(rows.at("eq33-corrected").at("verdict"), "accept") << rows.at("eq33-corrected").dump();
+  EXPECT_EQ(rows.at("eq33-corrected").at("p"), 1.0);
+  EXPECT_EQ(rows.at("eq33-printed").at("verdict"), "reject");
+  EXPECT_EQ(rows.at("eq33-printed").at("p"), 0.0);
+  fs::remove_all(out);
 }
 
 TEST(Cli, OneSphereIsReportedAsItsOwnLawAndDecidesNothing) {

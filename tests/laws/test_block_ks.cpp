@@ -129,6 +129,28 @@ TEST(BlockKs, UndecidedWhenTheSmallestPIsNotBelowAlpha) {
   EXPECT_EQ(r2[1].verdict, Verdict::accept);
 }
 
+TEST(BlockKs, ARejectionIsResolvedBelowTheFamilysThreshold) {
+  // A plainly wrong law (F = t^2 against uniform drops, D ~ 0.25) stops at p = 1/(B + 1) = 0.001
+  // (B = 999) when resolved to alpha: Holm over m = 10 tests at alpha = 0.01 needs p <= 0.001 and
+  // 10 x 0.001 = 0.01 is the edge; resolved to alpha/10 it goes on to B = 4999, p = 2e-4 <=
+  // alpha/50. The true law's verdict and D stay the same.
+  const auto x = sample(3, 2000);
+  const auto b = bin_by_block(x, 2000, 256);
+  const Cdf wrong = [](double t) { return std::clamp(t * t, 0.0, 1.0); };
+  const std::vector<Cdf> laws{wrong, kUniform};
+  const auto coarse = block_ks_tests(b, laws, 0.01, 1, 0);
+  const std::vector<double> resolve{0.001, 0.01};
+  const auto fine = block_ks_tests(b, laws, 0.01, 1, 0, 199, 9999, resolve);
+  std::printf("wrong law: p = %g (B = %zu) resolved to alpha, %g (B = %zu) resolved to alpha/10\n", coarse[0].p,
+              coarse[0].replicates, fine[0].p, fine[0].replicates);
+  EXPECT_EQ(coarse[0].p, 1.0 / 1000);
+  EXPECT_LE(fine[0].p, 0.001 / 5);
+  EXPECT_EQ(fine[0].verdict, Verdict::reject);
+  EXPECT_EQ(fine[1].verdict, coarse[1].verdict);
+  EXPECT_EQ(fine[1].D, coarse[1].D);
+  EXPECT_THROW(block_ks_tests(b, laws, 0.01, 1, 0, 199, 9999, std::vector<double>{0.001}), std::invalid_argument);
+}
+
 TEST(BlockKs, ReplicatesIdenticalForOneAndTwoThreads) {
   const auto x = sample(4, 6000, 60, 0.2);
   const auto b = bin_by_block(x, 60, 512);

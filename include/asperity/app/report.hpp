@@ -12,6 +12,7 @@
 #include "asperity/app/plan.hpp"
 #include "asperity/app/atomic_file.hpp"  // write_file_atomic, before it had a header of its own
 #include "asperity/app/scene.hpp"
+#include "asperity/laws/family.hpp"
 #include "asperity/laws/statistics.hpp"
 #include "asperity/laws/verdict.hpp"
 
@@ -75,7 +76,9 @@ struct GeometryReport {
   std::vector<PlanStage> plan;        ///< every stage, run or skipped with its reason, and its time
   std::string scene_toml;             ///< the scene that ran, as a scene file (to_toml)
 
-  /// A decisive test rejected its law.
+  /// The family of decisive tests (laws/family.hpp: Holm at scene.alpha over the decided ones).
+  FamilyDecision family() const;
+  /// The family rejects: some decisive test is rejected by Holm's procedure (exit status 1).
   bool rejected() const;
   /// Decisive tests that could not be evaluated (verdict "skipped") or not decided at the largest
   /// bootstrap size (verdict "undecided").
@@ -91,6 +94,10 @@ std::string format_table(const GeometryReport& r);
 
 /// Serialised report.json text.
 std::string to_json(const GeometryReport& r);
+
+/// report.json "family" as JSON text: procedure, alpha, tests (m), rejected, min_adjusted_p and
+/// adjusted_p by test name (names[i] for test i; a repeated name gets " #2", ...). Every kind of run.
+std::string family_json(const FamilyDecision& f, const std::vector<std::string>& names);
 
 /// The fields every report.json has, whatever kind of run wrote it (docs/report-json.md).
 struct ReportHeader {

@@ -46,7 +46,7 @@ struct SceneOutput {
   std::string json;                 ///< report.json text, with the common header (with_header)
   std::string table;                ///< the table for people (printed, and written as report.txt)
   std::vector<std::string> files;   ///< files the run wrote (figures, PLY), by name
-  bool rejected = false;            ///< a decisive test rejected its law (exit status 1)
+  bool rejected = false;            ///< the family of decisive tests rejects a law (Holm; exit status 1)
   /// Decisive tests that could not be evaluated (verdict "skipped"), one line each with the
   /// reason; the run still exits 0 unless a law was rejected (docs/cli.md).
   std::vector<std::string> skipped;

@@ -74,7 +74,7 @@ struct Scene {
   /// "fresh" or "fixed" when the scene named its mode by an earlier name (it runs as explicit; the
   /// report says so, legacy_mode_note); to_toml writes the name back. Empty otherwise.
   std::string legacy_mode;
-  double alpha = 0.01;        ///< significance level of each test
+  double alpha = 0.01;        ///< significance level of each test and of the family (Holm: the exit status)
   bool plots = true;          ///< write figures with their data as CSV (needs PLplot)
   /// outputs.plot_format (--plot-format): png, svg, pdf, png+svg, png+pdf (app/plot.hpp
   /// parse_plot_formats); the CSV is always written.

@@ -13,6 +13,7 @@
 #include "asperity/core/body.hpp"
 #include "asperity/experiments/ensemble.hpp"
 #include "asperity/core/mesh.hpp"
+#include "asperity/laws/family.hpp"
 #include "asperity/laws/figure.hpp"
 #include "asperity/laws/statistics.hpp"
 #include "asperity/laws/verdict.hpp"
@@ -64,12 +65,14 @@ struct RadiiReport {
   /// Wall seconds: screening (incl. the rotations of lognormal runs), fresh drops, tests, figures.
   double seconds_screen = 0, seconds_fresh = 0, seconds_analysis = 0, seconds_plots = 0;
 
-  /// A decisive test rejected its law.
+  /// The family of decisive tests rejects a law (Holm at experiment.alpha).
   bool rejected() const;
 };
 
-/// A decisive test rejected its law.
-bool decisive_rejection(const std::vector<LawCheck>& tests);
+/// The family of decisive checks at alpha (laws/family.hpp: Holm over the decided ones).
+FamilyDecision check_family(const std::vector<LawCheck>& tests, double alpha);
+/// The family rejects a law (Holm at alpha): the run exits 1.
+bool decisive_rejection(const std::vector<LawCheck>& tests, double alpha);
 /// Decisive tests that could not be evaluated (verdict "skipped": D and p NaN, the note says why).
 std::size_t decisive_skipped(const std::vector<LawCheck>& tests);
 

@@ -67,8 +67,12 @@ struct BlockKsResult {
 
 /// Tests every law in `laws` against the pooled sample on one set of replicates (adaptive B, from
 /// min_replicates up to max_replicates). `stream` keeps the replicates of different quantities apart.
+/// Law i is decided early once its p is clearly above alpha or clearly below resolve[i] (p <=
+/// resolve[i]/5; empty: alpha for every law). A run's family (laws/family.hpp, Holm) compares the
+/// smallest p with alpha/m: a decisive law of a run of m tests gets resolve = alpha/m or less, so
+/// that its rejection is not left at a floor (1/(B + 1) = 0.001 at B = 999) alpha/m cannot reach.
 std::vector<BlockKsResult> block_ks_tests(const BlockBins& b, std::span<const Cdf> laws, double alpha, std::uint64_t seed,
                                           std::uint64_t stream, std::size_t min_replicates = 199,
-                                          std::size_t max_replicates = 9999);
+                                          std::size_t max_replicates = 9999, std::span<const double> resolve = {});
 
 }  // namespace asperity

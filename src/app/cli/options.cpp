@@ -172,7 +172,7 @@ void add_options(CLI::App& app, RawOptions& r) {
                  "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only --threads, --kernel, "
                  "--quiet, --no-plots, --checkpoint-every may be given)")
       ->excludes(preset_opt);
-  app.add_option("--alpha", r.alpha, "significance level of each test, in (0,1)");
+  app.add_option("--alpha", r.alpha, "significance level of each test and of the run's family of decisive tests (Holm), in (0,1)");
   app.add_option("--out", r.out, "output directory for report.json and figures");
   app.add_option("--speed", r.speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
   app.add_option("--omega-x", r.omega_x, "impact: spin Omega_x before [rad/s]");
@@ -238,7 +238,8 @@ Parsed parse_arguments(CLI::App& app, std::span<const std::string> args) {
 constexpr const char* kHelpFooter =
     "\nExit status:\n"
     "  0  the run completed and no decisive law was rejected\n"
-    "  1  the run completed and the decisive family rejected a law (report.json \"rejected\")\n"
+    "  1  the run completed and the family of decisive tests rejected a law (Holm at --alpha;\n"
+    "     report.json \"rejected\", \"family\")\n"
     "  2  bad input or failure (the message names the option, key or file); the output directory\n"
     "     is left as it was\n"
     "\nManual: docs/README.md in the source tree (user guide, scene keys, report.json schema).\n";

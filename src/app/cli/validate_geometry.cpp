@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // validate-geometry: run a scene of explicit rough spheres, compare the contact statistics with
 // the paper's laws and the exact finite-N laws, print a table, write report.json and figures.
-// Exit status: 0 no law rejected (skipped laws: a warning), 1 a law rejected, 2 bad input or an
+// Exit status: 0 no law rejected (skipped laws: a warning), 1 the family of decisive tests rejects
+// a law (Holm at the run's alpha, laws/family.hpp; report.json "rejected"), 2 bad input or an
 // output that cannot be written.
 #include <malloc.h>
 #include <unistd.h>
