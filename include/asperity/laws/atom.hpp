@@ -14,9 +14,11 @@
 
 namespace asperity {
 
+/// The exact comparison of a degenerate sample or law (exact_atom_test): no bootstrap, which would
+/// have nothing to resample and sit at its floor p = 1/(B + 1).
 struct AtomTest {
   double D = 0;     ///< sup |F_n - F|, exact
-  double p = 1;
+  double p = 1;     ///< exact p-value: 1 (the sample is the law's atom), 0 (impossible under the law), or 2 m^units
   std::string note; ///< what was compared, for the report
 };
 

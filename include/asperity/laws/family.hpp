@@ -34,7 +34,7 @@ inline bool in_family(const LawTest& t) {
 
 /// The family-wise decision of a run at level alpha (report.json "family").
 struct FamilyDecision {
-  double alpha = 0;
+  double alpha = 0;                     ///< the family's level (the run's --alpha)
   std::size_t tests = 0;                ///< m: the members of the family
   std::vector<double> adjusted_p;       ///< per test given; NaN for a test outside the family
   std::vector<bool> reject;             ///< per test given: rejected by the family
