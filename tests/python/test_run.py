@@ -182,3 +182,28 @@ def test_ctrl_c_interrupts_a_bounce_run(tmp_path):
     timer.join()
     assert max(done, default=0) < 500_000
     assert not (tmp_path / "out-bounce").exists()
+
+
+def test_run_writes_no_file_unless_asked(small_scene, tmp_path, monkeypatch):
+    """out=None (the default) leaves the working directory and the scene's outputs.dir untouched;
+    out=DIR writes the figures (and their data) there and nowhere else; a scene whose outputs are
+    files is refused without out."""
+    monkeypatch.chdir(tmp_path)
+    scene = preset_dict("fig3")
+    scene["ensemble"].update(drops=4000, spheres=4)
+    scene["outputs"].update(plots=True, dir=str(tmp_path / "scene-dir"))
+    before = sorted(os.listdir(tmp_path))
+    r = asperity.run(scene, arrays=False)
+    assert sorted(os.listdir(tmp_path)) == before and r["plots"] == []
+    out = tmp_path / "figs"
+    r = asperity.run(scene, arrays=False, out=out)
+    assert r["plots"] and all((out / f).is_file() for f in r["plots"] + r["plot_data"])
+    assert not (tmp_path / "scene-dir").exists()
+    table = preset_dict("fig4")
+    table["asperities"]["count"] = 1000
+    table["ensemble"].update(drops=2000, mode="sampled")
+    table["outputs"]["cor_table"] = {"file": "t.csv"}
+    with pytest.raises(ValueError, match="out="):
+        asperity.run(table)
+    with pytest.raises(TypeError, match="out"):
+        asperity.run(scene, out=3)
