@@ -473,6 +473,19 @@ static inline int asperity_cor_parse(asperity_cor_table *t, const char *text, ch
   return -1;
 }
 
+/* Doubles the read buffer (one byte more for the terminating NUL), up to one byte past
+ * ASPERITY_COR_MAX_BYTES so that a larger file is seen to be larger. NULL, or why it cannot. */
+static inline const char *asperity_cor__grow(char **text, size_t *cap) {
+  char *q;
+  const size_t was = *cap;
+  *cap = was ? 2 * was : 65536;
+  if (*cap > (size_t)ASPERITY_COR_MAX_BYTES + 1) *cap = (size_t)ASPERITY_COR_MAX_BYTES + 1;
+  if (*cap == was) return "the table file is larger than ASPERITY_COR_MAX_BYTES";
+  if ((q = (char *)realloc(*text, *cap + 1)) == NULL) return "out of memory";
+  *text = q;
+  return NULL;
+}
+
 /** Reads and parses a table file. Returns 0, or -1 with a message in err (may be NULL). */
 static inline int asperity_cor_load(asperity_cor_table *t, const char *path, char *err, size_t err_size) {
   char *text = NULL;
@@ -494,20 +507,7 @@ static inline int asperity_cor_load(asperity_cor_table *t, const char *path, cha
   else if (st.st_size > (off_t)ASPERITY_COR_MAX_BYTES) why = "the table file is larger than ASPERITY_COR_MAX_BYTES";
   while (!why) {
     long got;
-    if (n == cap) {
-      char *q;
-      cap = cap ? 2 * cap : 65536;
-      if (cap > (size_t)ASPERITY_COR_MAX_BYTES + 1) cap = (size_t)ASPERITY_COR_MAX_BYTES + 1;
-      if (n == cap) {
-        why = "the table file is larger than ASPERITY_COR_MAX_BYTES";
-        break;
-      }
-      if ((q = (char *)realloc(text, cap + 1)) == NULL) {
-        why = "out of memory";
-        break;
-      }
-      text = q;
-    }
+    if (n == cap && (why = asperity_cor__grow(&text, &cap)) != NULL) break;
     got = (long)read(fd, text + n, cap - n);
     if (got < 0) why = "cannot read the table file";
     else if (got == 0) break;
@@ -520,20 +520,7 @@ static inline int asperity_cor_load(asperity_cor_table *t, const char *path, cha
   if (!f) why = "cannot open the table file";
   while (!why) {
     size_t got;
-    if (n == cap) {
-      char *q;
-      cap = cap ? 2 * cap : 65536;
-      if (cap > (size_t)ASPERITY_COR_MAX_BYTES + 1) cap = (size_t)ASPERITY_COR_MAX_BYTES + 1;
-      if (n == cap) {
-        why = "the table file is larger than ASPERITY_COR_MAX_BYTES";
-        break;
-      }
-      if ((q = (char *)realloc(text, cap + 1)) == NULL) {
-        why = "out of memory";
-        break;
-      }
-      text = q;
-    }
+    if (n == cap && (why = asperity_cor__grow(&text, &cap)) != NULL) break;
     got = fread(text + n, 1, cap - n, f);
     n += got;
     if (got == 0) {
