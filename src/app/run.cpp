@@ -29,6 +29,7 @@
 #include "asperity/app/scene_file.hpp"
 #include "asperity/app/stream_report.hpp"
 #include "asperity/app/checkpoint.hpp"
+#include "asperity/core/thread_count.hpp"
 
 namespace asperity {
 
@@ -467,9 +468,7 @@ std::string_view to_string(RunKind k) {
 SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log,
                              const std::filesystem::path& dir, Collective* group) {
   check_run(s);  // validate(s), the memory estimate, a mesh body's derived quantities: before any file is written
-#ifdef _OPENMP
-  if (s.ensemble.threads > 0) omp_set_num_threads(s.ensemble.threads);  // as run_contact_ensemble does
-#endif
+  const ThreadCountScope thread_scope(s.ensemble.threads);  // for this call only (core/thread_count.hpp)
   // Without a directory from the caller the run stages its own files in s.out and renames them
   // into place at the end: a failure leaves s.out as it was (output_staging.hpp).
   std::optional<OutputStaging> own;

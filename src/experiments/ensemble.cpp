@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/experiments/ensemble.hpp"
+#include "asperity/core/thread_count.hpp"
 #include "asperity/core/parallel_errors.hpp"
 
 #include <omp.h>
@@ -449,7 +450,7 @@ void explicit_drops(const EnsembleConfig& c, GuardedProgress& progress, ContactS
 ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& user_progress) {
   validate(c);
   GuardedProgress progress(user_progress);
-  if (c.threads > 0) omp_set_num_threads(c.threads);
+  const ThreadCountScope thread_scope(c.threads);
   ContactSamples s;
   s.mode = c.mode;
   resize(s, c.drops);

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/experiments/streaming.hpp"
+#include "asperity/core/thread_count.hpp"
 
 #include <omp.h>
 
@@ -395,7 +396,7 @@ ContactStream run_contact_stream(const EnsembleConfig& c, const Progress& progre
                                  const StreamState* resume, const StreamShare& share) {
   validate(c);
   if (c.impact.enabled) throw std::invalid_argument("streaming statistics: contact statistics only (no impact experiment)");
-  if (c.threads > 0) omp_set_num_threads(c.threads);
+  const ThreadCountScope thread_scope(c.threads);
   ContactStream out;
   out.state = resume ? *resume : initial_stream_state(c);
   if (resume && !(initial_stream_state(c).stats.size() == resume->stats.size() &&

@@ -17,6 +17,7 @@
 #include "asperity/app/report.hpp"
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
+#include "asperity/core/thread_count.hpp"
 #include "asperity/experiments/ensemble.hpp"
 #include "asperity/laws/block_ks.hpp"
 #include "asperity/laws/theory.hpp"
@@ -372,4 +373,23 @@ TEST(Progress, AnExceptionInTheCallbackStopsEveryMode) {
         << to_string(mode) << " x " << spheres;
     EXPECT_EQ(calls, 1u) << "the callback is not called again once it threw";
   }
+}
+
+// A library call with a thread count leaves the caller's OpenMP setting as it was (it used to call
+// omp_set_num_threads and keep it: a DEM code or Python user would run on 1 thread afterwards).
+TEST(Ensemble, AThreadCountLastsForTheCallOnly) {
+  const int before = omp_get_max_threads();
+  const int other = before == 1 ? 2 : 1;
+  EnsembleConfig c;
+  c.sphere.asperities = 1000;
+  c.mode = Mode::sampled;
+  c.drops = 2000;
+  c.threads = other;
+  (void)run_contact_ensemble(c);
+  EXPECT_EQ(omp_get_max_threads(), before);
+  {
+    const ThreadCountScope scope(other);
+    EXPECT_EQ(omp_get_max_threads(), other);  // the scope does set it (a no-op scope would fail here)
+  }
+  EXPECT_EQ(omp_get_max_threads(), before);
 }
