@@ -179,6 +179,20 @@ Figure band_figure(const BandFigure& fig) {
 PlotFormats parse_plot_formats(std::string_view text) {
   PlotFormats f{false, false, false};
   std::string_view rest = text;
+  if (const auto at = text.find('@'); at != std::string_view::npos) {
+    const std::string s(text.substr(at + 1));
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != s.size() || !(v >= 0.25 && v <= 8))
+      throw std::invalid_argument("plot format \"" + std::string(text) + "\": the size factor after '@' must be a number in [0.25, 8]");
+    f.scale = v;
+    rest = text.substr(0, at);
+  }
   while (!rest.empty()) {
     const auto plus = rest.find('+');
     const std::string_view part = rest.substr(0, plus);
@@ -199,6 +213,12 @@ std::string to_string(const PlotFormats& f) {
       if (!s.empty()) s += '+';
       s += name;
     }
+  if (f.scale != 1) {
+    std::ostringstream o;
+    o.imbue(std::locale::classic());
+    o << f.scale;
+    s += "@" + o.str();
+  }
   return s;
 }
 
@@ -354,7 +374,11 @@ std::vector<std::string> write_figure(const fs::path& dir, const std::string& st
     throw std::invalid_argument("write_figure: \"" + stem + "\" is not a plain file name");
   // Everything is drawn first (in memory): a figure PLplot cannot draw writes nothing.
   std::vector<std::pair<std::string, std::string>> files;
-  for (const auto& [format, ext] : formats_of(formats)) files.emplace_back(stem + ext, detail::render_figure(fig, format));
+  Figure sized = fig;
+  sized.width = static_cast<int>(std::lround(fig.width * formats.scale));
+  sized.height = static_cast<int>(std::lround(fig.height * formats.scale));
+  sized.resolution_scale = formats.scale;
+  for (const auto& [format, ext] : formats_of(formats)) files.emplace_back(stem + ext, detail::render_figure(sized, format));
   files.emplace_back(stem + ".csv", figure_csv(fig));
   std::vector<std::string> written;
   try {

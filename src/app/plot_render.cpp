@@ -331,14 +331,14 @@ void draw_panel(const Figure& fig, const Panel& p, double vx0, double vx1, doubl
   plslabelfunc(nullptr, nullptr);
   plmtex("b", 3.0, 0.5, 0.5, plplot_text(fig.xlabel).c_str());
   plmtex("l", ax.log ? 4.6 : 5.2, 0.5, 0.5, plplot_text(p.ylabel).c_str());
-  draw_legend(p, (vx1 - vx0) * fig.width, pal);
+  draw_legend(p, (vx1 - vx0) * fig.width / fig.resolution_scale, pal);
 }
 
 
 // The title, shrunk to fit the page width; a title too long even then is split in two lines at
 // the ", " or ": " nearest its middle (outside braces, so no sub/superscript is cut).
 void draw_title(const Figure& fig) {
-  const double fit = 0.95 * fig.width / kCharPixels;  // characters that fit at scale 1
+  const double fit = 0.95 * fig.width / fig.resolution_scale / kCharPixels;  // characters that fit at scale 1
   const std::string& t = fig.title;
   std::vector<std::string> lines{t};
   if (static_cast<double>(glyphs(t)) > fit / 0.65) {
@@ -362,7 +362,7 @@ void draw_title(const Figure& fig) {
   plcol0(1);
   plschr(0, scale);
   for (std::size_t k = 0; k < lines.size(); ++k) {
-    const double y = 1 - (lines.size() == 1 ? 32.0 : 20.0 + 26.0 * static_cast<double>(k)) / fig.height;
+    const double y = 1 - (lines.size() == 1 ? 32.0 : 20.0 + 26.0 * static_cast<double>(k)) * fig.resolution_scale / fig.height;
     plptex(0.5, y, 1, 0, 0.5, plplot_text(lines[k]).c_str());
   }
   plschr(0, kTextScale);
@@ -371,8 +371,10 @@ void draw_title(const Figure& fig) {
 void draw(const Figure& fig, Palette& pal) {
   pladv(0);
   plschr(0, kTextScale);
-  const double left = 95.0 / fig.width, right = 1 - 30.0 / fig.width;
-  const double top = 1 - 70.0 / fig.height, bottom = 72.0 / fig.height, gap = 90.0 / fig.height;
+  // Margins in pixels of the scale-1 page (PlotFormats::scale scales page and resolution alike).
+  const double px_x = fig.resolution_scale / fig.width, px = fig.resolution_scale / fig.height;
+  const double left = 95.0 * px_x, right = 1 - 30.0 * px_x;
+  const double top = 1 - 70.0 * px, bottom = 72.0 * px, gap = 90.0 * px;
   const auto n = static_cast<double>(fig.panels.size());
   const double h = (top - bottom - gap * (n - 1)) / n;
   for (std::size_t k = 0; k < fig.panels.size(); ++k) {
@@ -417,7 +419,10 @@ std::string render_figure(const Figure& fig, ImageFormat format) {
   plsdev(device_of(format));
   plsfile(out);  // closed by the driver in plend1
   plsError(&code, message);
-  plspage(0, 0, fig.width, fig.height, 0, 0);
+  // The resolution scales with the size (PlotFormats::scale): text and line sizes are in mm, so
+  // the drawing keeps its proportions at any size. 90 dpi is the cairo drivers' default.
+  const PLFLT dpi = 90.0 * fig.resolution_scale;
+  plspage(dpi, dpi, fig.width, fig.height, 0, 0);
   plscmap0n(static_cast<PLINT>(pal.colours.size()));
   for (std::size_t i = 0; i < pal.colours.size(); ++i)
     plscol0(static_cast<PLINT>(i), pal.colours[i].r, pal.colours[i].g, pal.colours[i].b);

@@ -149,8 +149,31 @@ TEST(Plot, FormatsParseAndRefuse) {
   EXPECT_EQ(to_string(parse_plot_formats("png")), "png");
   EXPECT_EQ(to_string(parse_plot_formats("png+pdf")), "png+pdf");
   EXPECT_EQ(to_string(parse_plot_formats("svg")), "svg");
-  for (const char* bad : {"", "jpg", "png+", "+png", "png+png", "PNG", "png pdf"})
+  for (const char* bad : {"", "jpg", "png+", "+png", "png+png", "PNG", "png pdf", "png@", "png@0.2", "png@9", "png@2x",
+                          "png@nan", "@2"})
     EXPECT_THROW(parse_plot_formats(bad), std::invalid_argument) << bad;
+  EXPECT_EQ(parse_plot_formats("png+svg@2.5").scale, 2.5);
+  EXPECT_EQ(to_string(parse_plot_formats("png+svg@2.5")), "png+svg@2.5");
+  EXPECT_EQ(parse_plot_formats("png").scale, 1);
+}
+
+// The size factor: the same figure at twice the pixels (a PNG's IHDR holds width and height).
+TEST(Plot, SizeFactorScalesThePage) {
+  if (!plotting_available()) GTEST_SKIP() << plotting_problem();
+  TempDir dir;
+  auto size_of = [](const fs::path& png) {
+    const std::string b = slurp(png);
+    auto be32 = [&](std::size_t at) {
+      return (std::uint32_t(std::uint8_t(b[at])) << 24) | (std::uint32_t(std::uint8_t(b[at + 1])) << 16) |
+             (std::uint32_t(std::uint8_t(b[at + 2])) << 8) | std::uint32_t(std::uint8_t(b[at + 3]));
+    };
+    return std::pair{be32(16), be32(20)};
+  };
+  const Figure fig = histogram_figure(gaussian_figure(2000));
+  write_figure(dir.path, "one", fig, parse_plot_formats("png"));
+  write_figure(dir.path, "two", fig, parse_plot_formats("png@2"));
+  EXPECT_EQ(size_of(dir.path / "one.png"), (std::pair<std::uint32_t, std::uint32_t>(fig.width, fig.height)));
+  EXPECT_EQ(size_of(dir.path / "two.png"), (std::pair<std::uint32_t, std::uint32_t>(2 * fig.width, 2 * fig.height)));
 }
 
 TEST(Plot, FailureThrowsAndLeavesNothing) {

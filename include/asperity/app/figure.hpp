@@ -66,6 +66,7 @@ struct Figure {
   double x_lo = 0, x_hi = 0;  ///< x_hi <= x_lo: from the data (log: decades)
   bool log_x = false;         ///< logarithmic x (values <= 0 are not drawn)
   int width = 900, height = 1000;  ///< pixels of the PNG (SVG/PDF: the same aspect)
+  double resolution_scale = 1;     ///< the page's resolution relative to 90 dpi (PlotFormats::scale)
   std::vector<Panel> panels;
   /// The panel whose series the CSV holds (the others show the same data differently).
   std::size_t data_panel = 0;

@@ -17,10 +17,14 @@ namespace asperity {
 /// The image formats written per figure (CSV is always written).
 struct PlotFormats {
   bool png = true, svg = false, pdf = false;
+  /// Size factor in [0.25, 8]: the page's pixels and its resolution scale together, so a figure at
+  /// scale 2 is the same drawing at twice the pixels (text, lines and margins keep their proportions).
+  double scale = 1;
 };
 
-/// "png", "svg", "pdf", "png+svg", "png+pdf" (also "svg+pdf", "png+svg+pdf"). Throws
-/// std::invalid_argument naming the accepted values.
+/// "png", "svg", "pdf", "png+svg", "png+pdf" (also "svg+pdf", "png+svg+pdf"), optionally followed by
+/// "@S", a size factor S in [0.25, 8] (e.g. "png@2": 1800 x 2000 pixels for a 900 x 1000 figure).
+/// Throws std::invalid_argument naming the accepted values.
 PlotFormats parse_plot_formats(std::string_view text);
 std::string to_string(const PlotFormats& f);
 

@@ -183,7 +183,7 @@ void add_options(CLI::App& app, RawOptions& r) {
                  "tangential law of the impacts: kinematic[:eps_t=E], coulomb:mu=M,restitution=newton|poisson|energetic, "
                  "stronge:mu=M, walton:mu=M,beta0=B (sphere impacts, the explicit bounce variants, mesh bodies)");
   app.add_flag("--no-plots", r.no_plots, "do not write figures (nor their data, CSV)");
-  app.add_option("--plot-format", r.plot_format, "figures as png (default), svg, pdf, png+svg or png+pdf; CSV always");
+  app.add_option("--plot-format", r.plot_format, "figures as png (default), svg, pdf, png+svg or png+pdf, optionally @S for S times the size (png@2); CSV always");
   app.add_flag("--quiet,-q", r.quiet, "print no progress");
 }
 
