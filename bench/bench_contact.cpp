@@ -55,6 +55,7 @@
 #include "asperity/core/orientation.hpp"
 #include "asperity/core/random.hpp"
 #include "directions.hpp"
+#include "timing.hpp"
 
 namespace {
 
@@ -66,12 +67,7 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using asperity::bench::median;
 
 // ---- options ------------------------------------------------------------------------------------
 

@@ -18,22 +18,15 @@
 #include "asperity/core/drop_kernel.hpp"
 #include "asperity/experiments/streaming.hpp"
 #include "core/drop_kernel_detail.hpp"
+#include "timing.hpp"
 
 using namespace asperity;
 
 namespace {
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using asperity::bench::median;
 
-template <class F>
-double timed(F f) {
-  const auto t0 = std::chrono::steady_clock::now();
-  f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
+using asperity::bench::timed;
 
 struct Args {
   std::uint64_t drops = 8000000, queries = 2000000;

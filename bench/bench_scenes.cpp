@@ -26,6 +26,7 @@
 #include "asperity/app/plan.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene.hpp"
+#include "timing.hpp"
 
 using namespace asperity;
 using Clock = std::chrono::steady_clock;
@@ -34,11 +35,7 @@ namespace {
 
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
+using asperity::bench::median;
 
 std::string loadavg() {
   std::ifstream f("/proc/loadavg");

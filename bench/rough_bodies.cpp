@@ -35,6 +35,7 @@
 #include <limits>
 #include <memory>
 #include <numbers>
+#include "timing.hpp"
 
 using namespace asperity;
 
@@ -130,10 +131,7 @@ void write_driver_report(const std::filesystem::path& dir, const std::string& wh
   std::cout << "wrote " << (dir / "report.json").string() << ", report.txt\n";
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using asperity::bench::median;
 
 // Gaussian curvature of |x/a|^m + |y/b|^m + |z/c|^m = 1 at p (mesh coordinates):
 // K = g^T adj(H) g / |g|^4 for the implicit F, H diagonal.
