@@ -1,4 +1,0 @@
-// SPDX-License-Identifier: GPL-3.0-or-later
-#pragma once
-// Moved to asperity/core/random.hpp (the core layer); this forwarding header goes after one release.
-#include "asperity/core/random.hpp"

@@ -1,4 +1,0 @@
-// SPDX-License-Identifier: GPL-3.0-or-later
-#pragma once
-// Moved to asperity/app/run.hpp (the app layer); this forwarding header goes after one release.
-#include "asperity/app/run.hpp"
