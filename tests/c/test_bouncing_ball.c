@@ -19,14 +19,7 @@
 
 #include <time.h>
 
-static int failures = 0;
-#define CHECK(cond)                                                              \
-  do {                                                                           \
-    if (!(cond)) {                                                               \
-      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
-      ++failures;                                                                \
-    }                                                                            \
-  } while (0)
+#include "check.h"
 
 /* A skewed law with a sharp upper edge, like asperity's: eps(p) = top - w (1 - p)^2, with top and w
  * depending on the speed; the impact (~0.99 m/s) falls between the grid speeds 0.5 and 2. */

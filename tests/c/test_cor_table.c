@@ -9,14 +9,7 @@
 #include <math.h>
 #include <stdio.h>
 
-static int failures = 0;
-#define CHECK(cond)                                                   \
-  do {                                                                \
-    if (!(cond)) {                                                    \
-      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
-      ++failures;                                                     \
-    }                                                                 \
-  } while (0)
+#include "check.h"
 #define NEAR(a, b) CHECK(fabs((a) - (b)) < 1e-12)
 
 static const char *kTable =
