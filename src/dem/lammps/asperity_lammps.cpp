@@ -1,0 +1,476 @@
+/* SPDX-License-Identifier: MIT */
+/* Copyright (c) 2026 the asperity developers. MIT (LICENSE's text); see asperity_draw.h. */
+// The LAMMPS styles of asperity_lammps.h. The contact force is the linear spring-dashpot with
+// Cundall-Strack tangential history (Cundall & Strack, Geotechnique 29, 47 (1979); the form of
+// LAMMPS's gran/hooke/history, written here from the model, not copied), except that the normal
+// damping is the absolute gamma_n (force -gamma_n d(delta)/dt) of the contact's own drawn eps.
+#include "asperity_lammps.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+#include "atom.h"
+#include "comm.h"
+#include "error.h"
+#include "force.h"
+#include "memory.h"
+#include "modify.h"
+#include "neigh_list.h"
+#include "neighbor.h"
+#include "update.h"
+#include "utils.h"
+
+using namespace LAMMPS_NS;
+
+namespace asperity_dem {
+
+// The std::string overloads of Error::all/one (the fmt ones are out of reach: fmt_stub/fmt/format.h).
+[[noreturn]] static void fail(LAMMPS* lmp, const std::string& why) { lmp->error->all(FLERR, why); }
+[[noreturn]] static void fail_one(LAMMPS* lmp, const std::string& why) { lmp->error->one(FLERR, why); }
+
+// ---- Draw: keywords, table, log ----
+
+int Draw::keyword(int n, char** args, int i, std::string& why) {
+  const std::string k = args[i];
+  if (k != "table" && k != "constant" && k != "seed" && k != "scale_damping" && k != "log") return 0;
+  if (i + 1 >= n) {
+    why = "keyword '" + k + "' needs a value";
+    return -1;
+  }
+  const char* v = args[i + 1];
+  char* end = nullptr;
+  errno = 0;
+  if (k == "constant" && std::strcmp(v, "none") == 0) {
+    constant_ = -1.0;  // no constant: the table decides (lets an input script pass both)
+  } else if (k == "table") {
+    table_path_ = v;
+  } else if (k == "log") {
+    log_path_ = std::strcmp(v, "none") == 0 ? "" : v;
+  } else if (k == "seed") {
+    const unsigned long long s = std::strtoull(v, &end, 10);
+    if (*v == '-' || !*v || *end || errno) {
+      why = std::string("seed '") + v + "': not an unsigned decimal integer below 2^64";
+      return -1;
+    }
+    seed_ = s, have_seed_ = true;
+  } else {
+    const double x = std::strtod(v, &end);
+    if (!*v || *end || errno || !std::isfinite(x)) {
+      why = k + " '" + v + "': not a finite number";
+      return -1;
+    }
+    if (k == "constant") {
+      if (!(x >= 0.0 && x <= 1.0)) {
+        why = std::string("constant '") + v + "': eps must lie in [0, 1]";
+        return -1;
+      }
+      constant_ = x;
+    } else {
+      if (!(x > 0.0)) {
+        why = std::string("scale_damping '") + v + "': must be > 0";
+        return -1;
+      }
+      damping_scale_ = x;
+    }
+  }
+  return 2;
+}
+
+bool Draw::finish(int rank, std::string& why) {
+  if (constant_ >= 0.0) table_path_.clear();  // 'constant EPS' wins over 'table FILE'
+  if (table_path_.empty() && constant_ < 0.0) {
+    why = "give 'table FILE' (eps drawn per contact) or 'constant EPS' (one eps for every contact)";
+    return false;
+  }
+  if (!table_path_.empty() && !have_seed_) {
+    why = "'table' needs 'seed S' (the key of the per-contact stream)";
+    return false;
+  }
+  if (!table_path_.empty()) {
+    char err[512];
+    if (asperity_cor_load(&table_, table_path_.c_str(), err, sizeof err) != 0) {
+      why = std::string("table: ") + err;
+      return false;
+    }
+    have_table_ = true;
+  }
+  if (!log_path_.empty()) {
+    const std::string path = rank == 0 ? log_path_ : log_path_ + "." + std::to_string(rank);
+    // A new file only: an existing log (or a link planted in its place) is never overwritten.
+    const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0 || (log_ = fdopen(fd, "w")) == nullptr) {
+      if (fd >= 0) close(fd);
+      why = "log '" + path + "': cannot create it (" + std::strerror(errno) + "; it must not exist yet)";
+      return false;
+    }
+    std::fprintf(log_, "# step kind id_a id_b approach_speed_m_s u eps gamma_n_kg_s\n");
+  }
+  return true;
+}
+
+// ---- The contact force ----
+
+namespace {
+
+struct Contact {
+  double del[3];  // x_i - x_j (pair) or x_i - wall point (wall)
+  double r;       // |del|
+  double overlap; // rad_i + rad_j - r > 0
+  double vr[3];   // v_i - v_j
+  double wr[3];   // (rad_i omega_i + rad_j omega_j) / r
+  double meff;
+};
+
+struct Params {
+  double kn, gamma, kt, gammat, xmu, dt;
+  bool shear_update;
+};
+
+// Normal: kn overlap - gamma_n d(delta)/dt along del; tangential: spring kt on the shear history plus
+// the dashpot meff gammat, capped by Coulomb xmu |F_n| (the history rescaled to the cap).
+// Returns the normal approach speed; writes the force on i (f) and its tangential part (fs).
+void hooke(const Contact& c, const Params& p, double* shear, double* f, double* fs) {
+  const double rinv = 1.0 / c.r, rsqinv = rinv * rinv;
+  const double vnnr = c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2];
+  double vtr[3];
+  for (int d = 0; d < 3; ++d) vtr[d] = c.vr[d] - c.del[d] * vnnr * rsqinv;
+  vtr[0] -= c.del[2] * c.wr[1] - c.del[1] * c.wr[2];
+  vtr[1] -= c.del[0] * c.wr[2] - c.del[2] * c.wr[0];
+  vtr[2] -= c.del[1] * c.wr[0] - c.del[0] * c.wr[1];
+  const double ccel = p.kn * c.overlap * rinv - p.gamma * vnnr * rsqinv;  // not clipped at 0 (header)
+  if (p.shear_update) {
+    for (int d = 0; d < 3; ++d) shear[d] += vtr[d] * p.dt;
+    // keep the history in the tangent plane as the contact normal turns
+    const double rsht = (shear[0] * c.del[0] + shear[1] * c.del[1] + shear[2] * c.del[2]) * rsqinv;
+    for (int d = 0; d < 3; ++d) shear[d] -= rsht * c.del[d];
+  }
+  const double shrmag = std::sqrt(shear[0] * shear[0] + shear[1] * shear[1] + shear[2] * shear[2]);
+  for (int d = 0; d < 3; ++d) fs[d] = -(p.kt * shear[d] + c.meff * p.gammat * vtr[d]);
+  const double fsmag = std::sqrt(fs[0] * fs[0] + fs[1] * fs[1] + fs[2] * fs[2]);
+  const double fn = p.xmu * std::fabs(ccel * c.r);
+  if (fsmag > fn) {
+    const double s = fn / fsmag;
+    for (int d = 0; d < 3; ++d) {
+      if (shrmag != 0.0 && p.kt > 0.0)
+        shear[d] = s * (shear[d] + c.meff * p.gammat * vtr[d] / p.kt) - c.meff * p.gammat * vtr[d] / p.kt;
+      fs[d] *= s;
+    }
+  }
+  for (int d = 0; d < 3; ++d) f[d] = c.del[d] * ccel + fs[d];
+}
+
+// kn kt gammat xmu: the four leading numbers of both styles.
+void read_contact_numbers(LAMMPS* lmp, char** arg, double* kn, double* kt, double* gammat, double* xmu) {
+  *kn = utils::numeric(FLERR, arg[0], false, lmp);
+  *kt = utils::numeric(FLERR, arg[1], false, lmp);
+  *gammat = utils::numeric(FLERR, arg[2], false, lmp);
+  *xmu = utils::numeric(FLERR, arg[3], false, lmp);
+  if (!(*kn > 0.0) || !(*kt >= 0.0) || !(*gammat >= 0.0) || !(*xmu >= 0.0))
+    fail(lmp, std::string("asperity: kn must be > 0, kt, gammat, xmu >= 0 (got ") + arg[0] + " " +
+                                         arg[1] + " " + arg[2] + " " + arg[3] + ")");
+}
+
+void require_sphere(LAMMPS* lmp, const char* who) {
+  Atom* atom = lmp->atom;
+  if (!atom->radius_flag || !atom->rmass_flag || !atom->omega_flag || !atom->torque_flag)
+    fail(lmp, std::string(who) + " needs atom_style sphere (radius, rmass, omega, torque)");
+  if (!atom->tag_enable) fail(lmp, std::string(who) + " needs atom IDs (they key the per-contact stream)");
+}
+
+}  // namespace
+
+// ---- FixRecords ----
+
+FixRecords::FixRecords(LAMMPS* lmp, int narg, char** arg) : Fix(lmp, narg, arg) {
+  // fix ID group asperity/records SLOTS WIDTH (created by pair_style asperity/hooke)
+  if (narg != 5) fail(lmp, "fix asperity/records: expected SLOTS WIDTH");
+  slots_ = utils::inumeric(FLERR, arg[3], false, lmp);
+  width_ = utils::inumeric(FLERR, arg[4], false, lmp);
+  if (slots_ < 1 || width_ < 1) fail(lmp, "fix asperity/records: SLOTS and WIDTH must be >= 1");
+  allocate();
+}
+
+FixRecords::FixRecords(LAMMPS* lmp, int narg, char** arg, int slots, int width)
+    : Fix(lmp, narg, arg), slots_(slots), width_(width) {
+  allocate();
+}
+
+void FixRecords::allocate() {
+  maxexchange = slots_ * width_;
+  grow_arrays(atom->nmax);
+  atom->add_callback(Atom::GROW);
+  for (int i = 0; i < atom->nlocal; ++i) set_arrays(i);
+}
+
+FixRecords::~FixRecords() {
+  atom->delete_callback(id, Atom::GROW);
+  memory->destroy(rec_);
+}
+
+void FixRecords::grow_arrays(int nmax) { memory->grow(rec_, nmax, slots_ * width_, "asperity/records:rec"); }
+
+void FixRecords::copy_arrays(int i, int j, int /*delflag*/) {
+  std::memcpy(rec_[j], rec_[i], sizeof(double) * slots_ * width_);
+}
+
+void FixRecords::set_arrays(int i) { std::memset(rec_[i], 0, sizeof(double) * slots_ * width_); }
+
+int FixRecords::pack_exchange(int i, double* buf) {
+  std::memcpy(buf, rec_[i], sizeof(double) * slots_ * width_);
+  return slots_ * width_;
+}
+
+int FixRecords::unpack_exchange(int nlocal, double* buf) {
+  std::memcpy(rec_[nlocal], buf, sizeof(double) * slots_ * width_);
+  return slots_ * width_;
+}
+
+double FixRecords::memory_usage() { return static_cast<double>(atom->nmax) * slots_ * width_ * sizeof(double); }
+
+// ---- PairHooke ----
+
+PairHooke::PairHooke(LAMMPS* lmp) : Pair(lmp) {
+  single_enable = 0;
+  no_virial_fdotr_compute = 1;
+  finitecutflag = 1;
+  records_id_ = "ASPERITY_PAIR_RECORDS";
+}
+
+PairHooke::~PairHooke() {
+  if (records_ && modify->find_fix(records_id_) >= 0) modify->delete_fix(records_id_);
+  if (allocated) {
+    memory->destroy(setflag);
+    memory->destroy(cutsq);
+  }
+}
+
+void PairHooke::settings(int narg, char** arg) {
+  if (narg < 4) fail(lmp, "pair_style asperity/hooke kn kt gammat xmu table FILE [constant EPS|none] seed S ...");
+  read_contact_numbers(lmp, arg, &kn_, &kt_, &gammat_, &xmu_);
+  std::string why;
+  for (int i = 4; i < narg;) {
+    const int used = draw_.keyword(narg, arg, i, why);
+    if (used < 0) fail(lmp, "pair_style asperity/hooke: " + why);
+    if (used == 0) fail(lmp, std::string("pair_style asperity/hooke: unknown keyword '") + arg[i] + "'");
+    i += used;
+  }
+  if (!draw_.finish(comm->me, why)) fail(lmp, "pair_style asperity/hooke: " + why);
+}
+
+void PairHooke::coeff(int narg, char** arg) {
+  if (narg != 2) fail(lmp, "pair_coeff for asperity/hooke takes no values: pair_coeff * *");
+  if (!allocated) {
+    const int n = atom->ntypes;
+    memory->create(setflag, n + 1, n + 1, "pair:setflag");
+    memory->create(cutsq, n + 1, n + 1, "pair:cutsq");
+    allocated = 1;
+  }
+  int ilo, ihi, jlo, jhi;
+  utils::bounds(FLERR, arg[0], 1, atom->ntypes, ilo, ihi, error);
+  utils::bounds(FLERR, arg[1], 1, atom->ntypes, jlo, jhi, error);
+  for (int i = 1; i <= atom->ntypes; ++i)
+    for (int j = 1; j <= atom->ntypes; ++j) setflag[i][j] = (i >= ilo && i <= ihi && j >= jlo && j <= jhi) ? 1 : 0;
+}
+
+void PairHooke::init_style() {
+  require_sphere(lmp, "pair_style asperity/hooke");
+  if (!comm->ghost_velocity) fail(lmp, "pair_style asperity/hooke needs 'comm_modify vel yes'");
+  // Every rank keeps both sides' records of a pair it sees and integrates them itself: newton off.
+  if (force->newton_pair) fail(lmp, "pair_style asperity/hooke needs 'newton off'");
+  if (modify->find_fix(records_id_) < 0)
+    modify->add_fix(records_id_ + " all asperity/records " + std::to_string(kSlots) + " " + std::to_string(WIDTH));
+  records_ = static_cast<FixRecords*>(modify->fix[modify->find_fix(records_id_)]);
+  double rmax = 0.0;
+  for (int i = 0; i < atom->nlocal; ++i) rmax = std::fmax(rmax, atom->radius[i]);
+  MPI_Allreduce(&rmax, &cut_, 1, MPI_DOUBLE, MPI_MAX, world);
+  cut_ *= 2.0;
+  if (!(cut_ > 0.0)) fail(lmp, "pair_style asperity/hooke: no atom with a radius > 0");
+  neighbor->request(this, instance_me);
+}
+
+double PairHooke::init_one(int, int) { return cut_; }
+
+double* PairHooke::find_or_add(int i, tagint partner, bool& fresh) {
+  double* free_slot = nullptr;
+  for (int s = 0; s < kSlots; ++s) {
+    double* r = records_->record(i, s);
+    if (r[PARTNER] == static_cast<double>(partner)) {
+      fresh = false;
+      return r;
+    }
+    if (!free_slot && r[PARTNER] == 0.0) free_slot = r;
+  }
+  if (!free_slot) fail_one(lmp, "pair_style asperity/hooke: atom " + std::to_string(atom->tag[i]) + " has more than " +
+                                std::to_string(kSlots) + " contacts");
+  std::memset(free_slot, 0, sizeof(double) * WIDTH);
+  free_slot[PARTNER] = static_cast<double>(partner);
+  fresh = true;
+  return free_slot;
+}
+
+void PairHooke::forget_ended() {
+  const double now = static_cast<double>(update->ntimestep);
+  for (int i = 0; i < atom->nlocal; ++i)
+    for (int s = 0; s < kSlots; ++s) {
+      double* r = records_->record(i, s);
+      if (r[PARTNER] != 0.0 && r[TOUCHED] != now) std::memset(r, 0, sizeof(double) * WIDTH);
+    }
+}
+
+void PairHooke::compute(int eflag, int vflag) {
+  ev_init(eflag, vflag);
+  double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const tagint* tag = atom->tag;
+  const int nlocal = atom->nlocal;
+  const bigint step = update->ntimestep;
+  Params p{kn_, 0.0, kt_, gammat_, xmu_, update->dt, update->setupflag == 0};
+  for (int ii = 0; ii < list->inum; ++ii) {
+    const int i = list->ilist[ii];
+    const int* jlist = list->firstneigh[i];
+    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+      const int j = jlist[jj] & NEIGHMASK;
+      Contact c;
+      for (int d = 0; d < 3; ++d) c.del[d] = x[i][d] - x[j][d];
+      const double rsq = c.del[0] * c.del[0] + c.del[1] * c.del[1] + c.del[2] * c.del[2];
+      const double radsum = radius[i] + radius[j];
+      if (rsq >= radsum * radsum) continue;  // not touching: its records are dropped below
+      c.r = std::sqrt(rsq);
+      c.overlap = radsum - c.r;
+      for (int d = 0; d < 3; ++d) {
+        c.vr[d] = v[i][d] - v[j][d];
+        c.wr[d] = (radius[i] * omega[i][d] + radius[j] * omega[j][d]) / c.r;
+      }
+      c.meff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
+      bool fresh_i = false, fresh_j = false;
+      double* ri = find_or_add(i, tag[j], fresh_i);
+      double* rj = j < nlocal ? find_or_add(j, tag[i], fresh_j) : nullptr;
+      if (fresh_i) {
+        // First touch: the approach speed now selects the table's row; one draw for the contact.
+        const double vn = -(c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2]) / c.r;
+        const std::uint64_t a = static_cast<std::uint64_t>(tag[i] < tag[j] ? tag[i] : tag[j]);
+        const std::uint64_t b = static_cast<std::uint64_t>(tag[i] < tag[j] ? tag[j] : tag[i]);
+        const double u = contact_uniform(draw_.seed(), a, b, step, ContactKind::pair);
+        ri[START] = static_cast<double>(step);
+        ri[EPS] = draw_.eps(vn, u);
+        ri[GAMMA] = draw_.gamma(ri[EPS], kn_, c.meff);
+        if (j < nlocal || tag[i] < tag[j]) draw_.log(step, ContactKind::pair, a, b, vn, u, ri[EPS], ri[GAMMA]);
+      }
+      p.gamma = ri[GAMMA];
+      double fij[3], fs[3];
+      hooke(c, p, ri + SHEAR, fij, fs);
+      ri[TOUCHED] = static_cast<double>(step);
+      const double tor[3] = {(c.del[1] * fs[2] - c.del[2] * fs[1]) / c.r, (c.del[2] * fs[0] - c.del[0] * fs[2]) / c.r,
+                             (c.del[0] * fs[1] - c.del[1] * fs[0]) / c.r};
+      for (int d = 0; d < 3; ++d) {
+        f[i][d] += fij[d];
+        torque[i][d] -= radius[i] * tor[d];
+      }
+      if (rj) {
+        // j's record mirrors i's: same contact, same eps and gamma, the shear history seen from j.
+        if (fresh_j) rj[START] = ri[START], rj[EPS] = ri[EPS], rj[GAMMA] = ri[GAMMA];
+        for (int d = 0; d < 3; ++d) {
+          rj[SHEAR + d] = -ri[SHEAR + d];
+          f[j][d] -= fij[d];
+          torque[j][d] -= radius[j] * tor[d];
+        }
+        rj[TOUCHED] = static_cast<double>(step);
+      }
+      if (evflag) ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, fij[0], fij[1], fij[2], c.del[0], c.del[1], c.del[2]);
+    }
+  }
+  forget_ended();
+  if (!draw_.flush_log()) fail_one(lmp, "pair_style asperity/hooke: cannot write the log");
+}
+
+// ---- FixWall ----
+
+FixWall::FixWall(LAMMPS* lmp, int narg, char** arg) : FixRecords(lmp, 3, arg, 1, WIDTH) {
+  // fix ID group asperity/wall/hooke kn kt gammat xmu zplane zlo table FILE [constant EPS|none] seed S [wall N] ...
+  if (narg < 9 || std::strcmp(arg[7], "zplane") != 0)
+    fail(lmp, "fix asperity/wall/hooke kn kt gammat xmu zplane ZLO table FILE [constant EPS|none] seed S "
+                      "[wall N] [scale_damping X] [log FILE]");
+  read_contact_numbers(lmp, arg + 3, &kn_, &kt_, &gammat_, &xmu_);
+  zlo_ = utils::numeric(FLERR, arg[8], false, lmp);
+  std::string why;
+  for (int i = 9; i < narg;) {
+    if (std::strcmp(arg[i], "wall") == 0) {
+      if (i + 1 >= narg) fail(lmp, "fix asperity/wall/hooke: 'wall' needs a number");
+      wall_ = static_cast<std::uint64_t>(utils::bnumeric(FLERR, arg[i + 1], false, lmp));
+      i += 2;
+      continue;
+    }
+    const int used = draw_.keyword(narg, arg, i, why);
+    if (used < 0) fail(lmp, "fix asperity/wall/hooke: " + why);
+    if (used == 0) fail(lmp, std::string("fix asperity/wall/hooke: unknown keyword '") + arg[i] + "'");
+    i += used;
+  }
+  if (!draw_.finish(comm->me, why)) fail(lmp, "fix asperity/wall/hooke: " + why);
+}
+
+int FixWall::setmask() { return LAMMPS_NS::FixConst::POST_FORCE; }
+
+void FixWall::init() { require_sphere(lmp, "fix asperity/wall/hooke"); }
+
+void FixWall::setup(int vflag) { post_force(vflag); }
+
+void FixWall::post_force(int) {
+  double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
+  const double *radius = atom->radius, *rmass = atom->rmass;
+  const int* mask = atom->mask;
+  const tagint* tag = atom->tag;
+  const bigint step = update->ntimestep;
+  Params p{kn_, 0.0, kt_, gammat_, xmu_, update->dt, update->setupflag == 0};
+  for (int i = 0; i < atom->nlocal; ++i) {
+    double* rec = record(i, 0);
+    const double dz = x[i][2] - zlo_;
+    if (!(mask[i] & groupbit) || dz >= radius[i] || dz <= 0.0) {
+      std::memset(rec, 0, sizeof(double) * WIDTH);  // not touching (or through the wall): no contact
+      continue;
+    }
+    Contact c;
+    c.del[0] = c.del[1] = 0.0, c.del[2] = dz;
+    c.r = dz;
+    c.overlap = radius[i] - dz;
+    for (int d = 0; d < 3; ++d) c.vr[d] = v[i][d], c.wr[d] = radius[i] * omega[i][d] / dz;
+    c.meff = rmass[i];  // the wall's mass is infinite
+    if (rec[ACTIVE] == 0.0) {
+      const double vn = -v[i][2];
+      const double u = contact_uniform(draw_.seed(), static_cast<std::uint64_t>(tag[i]), wall_, step, ContactKind::wall);
+      rec[ACTIVE] = 1.0;
+      rec[START] = static_cast<double>(step);
+      rec[EPS] = draw_.eps(vn, u);
+      rec[GAMMA] = draw_.gamma(rec[EPS], kn_, c.meff);
+      draw_.log(step, ContactKind::wall, static_cast<std::uint64_t>(tag[i]), wall_, vn, u, rec[EPS], rec[GAMMA]);
+    }
+    p.gamma = rec[GAMMA];
+    double fw[3], fs[3];
+    hooke(c, p, rec + SHEAR, fw, fs);
+    for (int d = 0; d < 3; ++d) f[i][d] += fw[d];
+    torque[i][0] -= radius[i] * (c.del[1] * fs[2] - c.del[2] * fs[1]) / c.r;
+    torque[i][1] -= radius[i] * (c.del[2] * fs[0] - c.del[0] * fs[2]) / c.r;
+    torque[i][2] -= radius[i] * (c.del[0] * fs[1] - c.del[1] * fs[0]) / c.r;
+  }
+  if (!draw_.flush_log()) fail_one(lmp, "fix asperity/wall/hooke: cannot write the log");
+}
+
+// ---- Registration ----
+
+namespace {
+Pair* make_pair(LAMMPS* lmp) { return new PairHooke(lmp); }
+Fix* make_records(LAMMPS* lmp, int narg, char** arg) { return new FixRecords(lmp, narg, arg); }
+Fix* make_wall(LAMMPS* lmp, int narg, char** arg) { return new FixWall(lmp, narg, arg); }
+}  // namespace
+
+void register_styles(LAMMPS* lmp) {
+  (*lmp->force->pair_map)["asperity/hooke"] = &make_pair;
+  (*lmp->modify->fix_map)["asperity/records"] = &make_records;
+  (*lmp->modify->fix_map)["asperity/wall/hooke"] = &make_wall;
+}
+
+}  // namespace asperity_dem

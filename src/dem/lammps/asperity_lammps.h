@@ -1,0 +1,92 @@
+/* SPDX-License-Identifier: MIT */
+/* Copyright (c) 2026 the asperity developers. MIT (LICENSE's text); see asperity_draw.h. */
+// LAMMPS styles that draw the restitution coefficient per contact from an asperity table, built
+// against the headers Debian's liblammps-dev ships (20220106: pair.h, fix.h, atom.h, ...; not the
+// GRANULAR package's headers, so nothing here depends on their class layout):
+//   pair_style asperity/hooke   linear spring-dashpot + Cundall-Strack tangential history, like
+//                               gran/hooke/history, but with gamma_n per contact;
+//   fix asperity/wall/hooke     the same contact against the plane z = zlo;
+//   fix asperity/records        per-atom contact records (created by the pair style).
+// register_styles() puts their creators into a LAMMPS instance's style maps, as LAMMPS's plugin
+// loader does (Debian's LAMMPS has no PLUGIN package). docs/dem-coupling.md has the syntax.
+#pragma once
+
+#include <string>
+
+#include "fix.h"
+#include "pair.h"
+
+#include "asperity_draw.h"
+
+namespace asperity_dem {
+
+/// Per-atom storage of `slots` contact records of `width` doubles each, migrated with its atom
+/// (Comm::exchange) and grown with the atom arrays. Free records have record[0] == 0.
+class FixRecords : public LAMMPS_NS::Fix {
+ public:
+  FixRecords(LAMMPS_NS::LAMMPS* lmp, int narg, char** arg);
+  ~FixRecords() override;
+  int setmask() override { return 0; }
+  void grow_arrays(int nmax) override;
+  void copy_arrays(int i, int j, int delflag) override;
+  void set_arrays(int i) override;
+  int pack_exchange(int i, double* buf) override;
+  int unpack_exchange(int nlocal, double* buf) override;
+  double memory_usage() override;
+
+  double* record(int i, int slot) { return rec_[i] + slot * width_; }
+  int slots() const { return slots_; }
+  int width() const { return width_; }
+
+ protected:
+  FixRecords(LAMMPS_NS::LAMMPS* lmp, int narg, char** arg, int slots, int width);
+  void allocate();
+  int slots_ = 0, width_ = 0;
+  double** rec_ = nullptr;
+};
+
+/// pair_style asperity/hooke kn kt gammat xmu table FILE [constant EPS|none] seed S [scale_damping X] [log FILE]
+class PairHooke : public LAMMPS_NS::Pair {
+ public:
+  explicit PairHooke(LAMMPS_NS::LAMMPS* lmp);
+  ~PairHooke() override;
+  void compute(int eflag, int vflag) override;
+  void settings(int narg, char** arg) override;
+  void coeff(int narg, char** arg) override;
+  void init_style() override;
+  double init_one(int i, int j) override;
+
+ private:
+  // A pair record: partner id (0: free), start step, eps, gamma_n, shear[3], last step touched.
+  enum { PARTNER, START, EPS, GAMMA, SHEAR, TOUCHED = SHEAR + 3, WIDTH };
+  static constexpr int kSlots = 16;
+  double* find_or_add(int i, LAMMPS_NS::tagint partner, bool& fresh);
+  void forget_ended();
+  double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0, cut_ = 0;
+  Draw draw_;
+  FixRecords* records_ = nullptr;
+  std::string records_id_;
+};
+
+/// fix ID group asperity/wall/hooke kn kt gammat xmu zplane zlo table FILE [constant EPS|none] seed S
+///     [wall N] [scale_damping X] [log FILE]
+class FixWall : public FixRecords {
+ public:
+  FixWall(LAMMPS_NS::LAMMPS* lmp, int narg, char** arg);
+  int setmask() override;
+  void init() override;
+  void setup(int vflag) override;
+  void post_force(int vflag) override;
+
+ private:
+  // The atom's wall record: in contact (0/1), start step, eps, gamma_n, shear[3].
+  enum { ACTIVE, START, EPS, GAMMA, SHEAR, WIDTH = SHEAR + 3 };
+  double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0, zlo_ = 0;
+  std::uint64_t wall_ = 1;
+  Draw draw_;
+};
+
+/// Makes "asperity/hooke", "asperity/wall/hooke" and "asperity/records" known to `lmp`.
+void register_styles(LAMMPS_NS::LAMMPS* lmp);
+
+}  // namespace asperity_dem

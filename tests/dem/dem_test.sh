@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-3.0-or-later
+# The LAMMPS coupling's tests (ctest -L dem; docs/dem-coupling.md). Each case runs asperity-lammps
+# on the examples in a fresh directory and checks the output with dem_check.
+#   dem_test.sh CASE LMP VG CHECK SRC WORK
+# LMP = "" (asperity-lammps not built: no liblammps-dev) -> exit 77, which ctest reports as skipped.
+set -euo pipefail
+case_=$1 lmp=$2 vg=$3 check=$4 src=$5 work=$6
+if [ -z "$lmp" ]; then
+  echo "SKIPPED: asperity-lammps is not built (Debian's liblammps-dev + lammps are not installed: apt-get install lammps liblammps-dev, then configure again)"
+  exit 77
+fi
+ex=$src/examples/dem
+table=$work/table/rough-sphere.csv
+fresh() { rm -rf "$work/$1" && mkdir -p "$work/$1" && cd "$work/$1"; }
+lammps() { "$lmp" -in "$1" -screen none -log lammps.log "${@:2}"; }
+
+case $case_ in
+  table)  # the restitution table, written by the product from the example scene
+    rm -rf "$work/table"
+    "$vg" -q --no-plots --scene "$ex/rough-sphere.toml" --out "$work/table"
+    head -1 "$table" ;;
+  headon)  # 10^4 head-on collisions at 1 m/s: achieved eps ~ the table's law at 1 m/s
+    fresh headon
+    lammps "$ex/two-spheres.in" -var table "$table" -var pairs 10000
+    "$check" headon "$table" contacts.log final.dump 1.0 accept ;;
+  wrong_damping)  # the same with every gamma_n 1 % too large: must be rejected
+    fresh wrong_damping
+    lammps "$ex/two-spheres.in" -var table "$table" -var pairs 10000 -var scale 1.01
+    "$check" headon "$table" contacts.log final.dump 1.0 reject ;;
+  bounce)  # 225 balls x 50 impacts on the plate: residuals ~ Eq. 2 at the Sec. V rates
+    fresh bounce
+    lammps "$ex/bouncing-ball.in" -var table "$table" -var balls 225 -var impacts 50
+    "$check" bounce "$table" impacts.log ;;
+  ranks)  # the same contacts, eps and final velocities on 1 and 2 MPI ranks (each pair split over both)
+    fresh ranks
+    # one start for both (create_atoms numbers atoms by rank): written by a first run
+    lammps "$ex/two-spheres.in" -var table "$table" -var pairs 400 -var log zero.log -var out zero.dump -var start save
+    lammps "$ex/two-spheres.in" -var table "$table" -var start load -var log one.log -var out one.dump
+    mpirun --allow-run-as-root --oversubscribe -np 2 "$lmp" -in "$ex/two-spheres.in" -screen none -log two.lammps \
+      -var table "$table" -var start load -var px 2 -var log two.log -var out two.dump
+    grep -v "^#" one.log | sort > one.sorted && cat two.log two.log.1 | grep -v "^#" | sort > two.sorted
+    grep -c pair one.sorted
+    cmp one.sorted two.sorted && cmp one.dump two.dump && echo "ranks: 1 and 2 ranks gave the same contacts, eps and velocities" ;;
+  examples)  # the commands of docs/dem-coupling.md, as written there (in a copy of examples/dem)
+    fresh examples
+    cp "$ex"/two-spheres.in "$ex"/bouncing-ball.in "$table" .
+    "$lmp" -in two-spheres.in -var table rough-sphere.csv
+    "$lmp" -in bouncing-ball.in -var table rough-sphere.csv
+    test "$(grep -c pair contacts.log)" = 1 && test "$(grep -c wall impacts.log)" = 50
+    echo "examples: 1 pair contact, 50 impacts" ;;
+  *) echo "unknown case $case_" >&2; exit 2 ;;
+esac
