@@ -42,6 +42,15 @@ case $case_ in
     grep -v "^#" one.log | sort > one.sorted && cat two.log two.log.1 | grep -v "^#" | sort > two.sorted
     grep -c pair one.sorted
     cmp one.sorted two.sorted && cmp one.dump two.dump && echo "ranks: 1 and 2 ranks gave the same contacts, eps and velocities" ;;
+  native)  # with one eps for every contact, the coupling's force is LAMMPS's own gran/hooke/history
+    fresh native
+    lammps "$ex/two-spheres.in" -var table none -var constant 0.95 -var pairs 100 -var log none -var out asperity.dump
+    lammps "$ex/two-spheres.in" -var table none -var constant 0.95 -var pairs 100 -var native 1 -var out native.dump
+    paste <(sed -n '/ITEM: ATOMS/,$p' asperity.dump | tail -n +2) <(sed -n '/ITEM: ATOMS/,$p' native.dump | tail -n +2) |
+      awk '$1 != $4 {print "atom order differs"; exit 1}
+           {d = $3 - $6; d = d < 0 ? -d : d; m = d > m ? d : m; if ($2 == 2) e += 2 * $3; n += $2 == 2}
+           END {printf "native: %d pairs, max |vx(asperity) - vx(gran/hooke/history)| = %.3g m/s (bound 1e-12), mean eps %.8f (0.95)\n", n, m, e / n
+                exit !(n == 100 && m < 1e-12 && e / n > 0.9499 && e / n < 0.9501)}' ;;
   examples)  # the commands of docs/dem-coupling.md, as written there (in a copy of examples/dem)
     fresh examples
     cp "$ex"/two-spheres.in "$ex"/bouncing-ball.in "$table" .

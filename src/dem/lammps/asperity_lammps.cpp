@@ -295,31 +295,43 @@ void PairHooke::init_style() {
 
 double PairHooke::init_one(int, int) { return cut_; }
 
+// An atom's active records are kept at the front of its slots (forget_ended compacts them), so a
+// search stops at the first free slot: one or two comparisons for a particle with one contact.
 double* PairHooke::find_or_add(int i, tagint partner, bool& fresh) {
-  double* free_slot = nullptr;
+  const double key = static_cast<double>(partner);
   for (int s = 0; s < kSlots; ++s) {
     double* r = records_->record(i, s);
-    if (r[PARTNER] == static_cast<double>(partner)) {
+    if (r[PARTNER] == key) {
       fresh = false;
       return r;
     }
-    if (!free_slot && r[PARTNER] == 0.0) free_slot = r;
+    if (r[PARTNER] == 0.0) {
+      std::memset(r, 0, sizeof(double) * WIDTH);
+      r[PARTNER] = key;
+      fresh = true;
+      return r;
+    }
   }
-  if (!free_slot) fail_one(lmp, "pair_style asperity/hooke: atom " + std::to_string(atom->tag[i]) + " has more than " +
-                                std::to_string(kSlots) + " contacts");
-  std::memset(free_slot, 0, sizeof(double) * WIDTH);
-  free_slot[PARTNER] = static_cast<double>(partner);
-  fresh = true;
-  return free_slot;
+  fail_one(lmp, "pair_style asperity/hooke: atom " + std::to_string(atom->tag[i]) + " has more than " +
+                    std::to_string(kSlots) + " contacts");
 }
 
 void PairHooke::forget_ended() {
   const double now = static_cast<double>(update->ntimestep);
-  for (int i = 0; i < atom->nlocal; ++i)
-    for (int s = 0; s < kSlots; ++s) {
+  for (int i = 0; i < atom->nlocal; ++i) {
+    int n = 0;
+    while (n < kSlots && records_->record(i, n)[PARTNER] != 0.0) ++n;
+    for (int s = 0; s < n;) {
       double* r = records_->record(i, s);
-      if (r[PARTNER] != 0.0 && r[TOUCHED] != now) std::memset(r, 0, sizeof(double) * WIDTH);
+      if (r[TOUCHED] == now) {
+        ++s;
+        continue;
+      }
+      double* last = records_->record(i, --n);  // the contact ended: the last active record takes its slot
+      if (last != r) std::memcpy(r, last, sizeof(double) * WIDTH);
+      std::memset(last, 0, sizeof(double) * WIDTH);
     }
+  }
 }
 
 void PairHooke::compute(int eflag, int vflag) {
