@@ -184,6 +184,11 @@ int bounce(const std::string& log) {
   std::printf("bounce: Eq. 2 fitted to residual/a1(u): mode %.4g +- %.2g, left rate a = %.4f +- %.4f (predicted 1), "
               "right rate c = %.4g (predicted infinite)\n",
               fit.m.value, fit.m.se, fit.a.value, fit.a.se, fit.c.value);
+  for (const double u : {1.0, 0.3, 0.1}) {
+    const auto law = asperity::bounce_residual_laws(rough_sphere(u), 1).at(0);
+    std::printf("bounce: Sec. V law at u = %.1f m/s: eps_n = %.6f, left rate 1/a1 = %.1f, right rate %g\n", u, law.eps_n,
+                law.rate_below(), law.rate_above());
+  }
   std::printf("bounce: max |achieved - drawn| = %.3g (bound 2e-4)\n", max_diff);
   return ok_law && wrong_rejected && ok_rate && one_sided && max_diff < 2e-4 ? 0 : 1;
 }
