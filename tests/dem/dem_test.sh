@@ -59,6 +59,21 @@ case $case_ in
            {d = $3 - $6; d = d < 0 ? -d : d; m = d > m ? d : m; if ($2 == 2) e += 2 * $3; n += $2 == 2}
            END {printf "native: %d pairs, max |vx(asperity) - vx(gran/hooke/history)| = %.3g m/s (bound 1e-12), mean eps %.8f (0.95)\n", n, m, e / n
                 exit !(n == 100 && m < 1e-12 && e / n > 0.9499 && e / n < 0.9501)}' ;;
+  bench)  # the cost scripts of docs/dem-coupling.md section 5, at a tiny size (the figures there come from the full size)
+    fresh bench
+    build=$(dirname "$(dirname "$(dirname "$lmp")")")
+    "$src/bench/dem_lammps_cost.sh" "$build" "$table" 20 1 | tee cost.out
+    grep -q "^per contact (1000 steps each): table - constant" cost.out
+    ;;
+  bench_ir)  # the callgrind script of docs/dem-coupling.md section 5, at 2 and 4 pairs (~1-2 min)
+    if ! command -v valgrind > /dev/null; then
+      echo "SKIPPED: valgrind is not installed (bench/dem_lammps_instructions.sh needs callgrind)"
+      exit 77
+    fi
+    fresh bench_ir
+    build=$(dirname "$(dirname "$(dirname "$lmp")")")
+    "$src/bench/dem_lammps_instructions.sh" "$build" "$table" 2 | tee ir.out
+    grep -Eq "^table - constant: -?[0-9]+ instructions per contact" ir.out ;;
   examples)  # the commands of docs/dem-coupling.md, as written there (in a copy of examples/dem)
     fresh examples
     cp "$ex"/two-spheres.in "$ex"/bouncing-ball.in "$table" .
