@@ -50,6 +50,17 @@ case $case_ in
     grep -v "^#" one.log | sort > one.sorted && cat two.log two.log.1 | grep -v "^#" | sort > two.sorted
     grep -c pair one.sorted
     cmp one.sorted two.sorted && cmp one.dump two.dump && echo "ranks: 1 and 2 ranks gave the same contacts, eps and velocities" ;;
+  migrate)  # pairs drifting at 20 m/s across the rank boundary in mid-contact (kn 1e5: a 0.2 ms contact);
+    # the contact records travel with their atoms: the same draws and velocities on 1 and 2 ranks
+    fresh migrate
+    common=(-var table "$table" -var pairs 100 -var drift 20 -var xb p -var kn 1e5)
+    lammps "$ex/two-spheres.in" "${common[@]}" -var log zero.log -var out zero.dump -var start save
+    lammps "$ex/two-spheres.in" "${common[@]}" -var start load -var log one.log -var out one.dump
+    mpirun --allow-run-as-root --oversubscribe -np 2 "$lmp" -in "$ex/two-spheres.in" -screen none -log two.lammps \
+      "${common[@]}" -var start load -var px 2 -var log two.log -var out two.dump
+    grep -v "^#" one.log | sort > one.sorted && cat two.log two.log.1 | grep -v "^#" | sort > two.sorted
+    test "$(wc -l < one.sorted)" = 100
+    cmp one.sorted two.sorted && cmp one.dump two.dump && echo "migrate: 100 contacts crossed ranks; the same draws and velocities on 1 and 2 ranks" ;;
   native)  # with one eps for every contact, the coupling's force is LAMMPS's own gran/hooke/history
     fresh native
     lammps "$ex/two-spheres.in" -var table none -var constant 0.95 -var pairs 100 -var log none -var out asperity.dump
