@@ -61,6 +61,22 @@ case $case_ in
     grep -v "^#" one.log | sort > one.sorted && cat two.log two.log.1 | grep -v "^#" | sort > two.sorted
     test "$(wc -l < one.sorted)" = 100
     cmp one.sorted two.sorted && cmp one.dump two.dump && echo "migrate: 100 contacts crossed ranks; the same draws and velocities on 1 and 2 ranks" ;;
+  bad_input)  # refusals name the key and the value, exit 1, and write no log
+    fresh bad_input
+    printf '# asperity-cor-table format=1 speeds=1 probabilities=2\nspeed_m_s,p=0,p=1\n1,0.9,0.8\n' > bad.csv
+    refused() {  # refused EXPECTED_MESSAGE lammps-args...
+      local want=$1; shift
+      if "$lmp" -log none "$@" > out.txt 2>&1; then echo "accepted: $*"; return 1; fi
+      grep -F -- "$want" out.txt || { cat out.txt; return 1; }
+    }
+    refused "pair_style asperity/hooke: table: line 3: '0.8': quantiles must not decrease along a row" \
+      -in "$ex/two-spheres.in" -var table bad.csv -var log none
+    refused "fix asperity/wall/hooke: table: line 3: '0.8': quantiles must not decrease along a row" \
+      -in "$ex/bouncing-ball.in" -var table bad.csv -var log none
+    refused "constant '1.5': eps must lie in [0, 1]" -in "$ex/two-spheres.in" -var table "$table" -var constant 1.5 -var log none
+    touch taken.log
+    refused "log 'taken.log': cannot create it" -in "$ex/two-spheres.in" -var table "$table" -var log taken.log
+    test ! -s taken.log && echo "bad_input: 4 refusals" ;;
   native)  # with one eps for every contact, the coupling's force is LAMMPS's own gran/hooke/history
     fresh native
     lammps "$ex/two-spheres.in" -var table none -var constant 0.95 -var pairs 100 -var log none -var out asperity.dump
