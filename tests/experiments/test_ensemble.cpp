@@ -156,7 +156,7 @@ TEST(Explicit, CalibrationTrueLawRejectedAtAlpha) {
   std::size_t rejected = 0;
   for (std::size_t seed = 1; seed <= seeds; ++seed) {
     EnsembleConfig c;
-    c.sphere = {50, 3e-3, 6.5e-7};
+    c.sphere = {50, 3e-3, 1e-3};  // core contacts (1 - a/2R)^50 = 1.1e-4 of drops: the premise holds
     c.mode = Mode::explicit_spheres;
     c.spheres = 50;
     c.drops = 5000;
