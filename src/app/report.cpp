@@ -587,7 +587,8 @@ std::string format_table(const GeometryReport& r) {
      << r.scene.ensemble.seed << "\n";
   os << "lengths in micrometres, omega in rad/s; KS = one-sample Kolmogorov-Smirnov (iid), KS-sphere-bootstrap = KS of "
         "all drops with a sphere-block bootstrap p, alpha = "
-     << r.scene.alpha << " per test\n\n";
+     << r.scene.alpha << " per test; the exit status is the family's: Holm's step-down over the decided decisive tests "
+        "(Holm p, family)\n\n";
   os << std::left << std::setw(14) << "quantity" << std::setw(24) << "measured mean +- se" << std::setw(18) << "law"
      << std::setw(12) << "law mean" << std::setw(21) << "test" << std::setw(10) << "KS D" << std::setw(11) << "p"
      << std::setw(11) << "Holm p" << std::setw(8) << "family" << "verdict\n";

@@ -157,6 +157,61 @@ double model_error_scale(std::uint64_t n, double R) {
   return d;
 }
 
+namespace {
+// The log ratio r = log(p/q) of the folded s = sin^2(theta/2) on [0, 1/2] (kl_exact_eq14):
+// p = N (1-s)^(N-1) (1 + (s/(1-s))^(N-1)), q = N (1 - 2s) exp(-N s (1-s)); the O(1) terms of
+// (N-1) log(1-s) + N s (1-s) cancel to O(1/N), so they are grouped before adding.
+double kl_log_ratio(double n, double s) {
+  const double fold = s > 0 ? std::exp((n - 1) * std::log(s / (1.0 - s))) : (n == 1 ? 1.0 : 0.0);
+  return (n - 1) * (std::log1p(-s) + s) + s - n * s * s + std::log1p(fold) - std::log1p(-2.0 * s);
+}
+}  // namespace
+
+double kl_exact_eq14(std::uint64_t n_int) {
+  if (n_int < 2) throw std::invalid_argument("kl_exact_eq14: N must be >= 2");
+  const double n = static_cast<double>(n_int);
+  // KL = int p log(p/q) = int [p log(p/q) - p + q] + int (p - q); the first integrand is
+  // q (1 + (r - 1) e^r) ~ q r^2 / 2 >= 0 (no cancellation between large terms), the second is
+  // 1 - (1 - exp(-N/4)) exactly (p has mass 1 on [0, 1/2], q its Rayleigh mass below t = R).
+  auto term = [n](double s) {
+    if (s >= 0.5) return 0.0;
+    const double r = kl_log_ratio(n, s);
+    const double q = n * (1.0 - 2.0 * s) * std::exp(-n * s * (1.0 - s));
+    const double em1 = std::expm1(r);
+    const double p = q * (1.0 + em1);
+    if (!(q > 0)) return 0.0;                 // q underflowed: p (<= q e^r) is negligible there too
+    if (std::abs(r) > 0.5) return p * r - p + q;  // no cancellation to avoid
+    return q * (r * em1 + (r - em1));
+  };
+  double sum = 0, lo = 0;
+  for (int k = 1; lo < 0.5 && k <= 96; ++k) {  // pieces of width 1/N: p and q vary on that scale
+    const double hi = std::min(0.5, k / n);
+    sum += boost::math::quadrature::gauss_kronrod<double, 31>::integrate(term, lo, hi, 6, 1e-11);
+    lo = hi;
+  }
+  if (lo < 0.5) sum += boost::math::quadrature::gauss_kronrod<double, 31>::integrate(term, lo, 0.5, 10, 1e-11);
+  return sum + std::exp(-n / 4.0);
+}
+
+double kl_exact_eq14_direct(std::uint64_t n, double R) {
+  const Law e = exact_sphere_rxy(n, R), q = eq14_rxy(n, R);
+  auto f = [&](double t) {
+    const double pe = e.pdf(t), pq = q.pdf(t);
+    return pe > 0 && pq > 0 ? pe * std::log(pe / pq) : 0.0;
+  };
+  const double sigma = 1.0 / std::sqrt(2.0 * pi * areal_density(n, R));
+  const double hi = std::min(R, 14.0 * sigma);
+  double sum = 0, lo = 0;
+  for (int k = 1; lo < hi; ++k) {
+    const double b = std::min(hi, k * 0.25 * sigma);
+    sum += boost::math::quadrature::gauss_kronrod<double, 61>::integrate(f, lo, b, 8, 1e-10);
+    lo = b;
+  }
+  return sum;
+}
+
+double lr_drops_for_z(std::uint64_t n, double z) { return z * z / (2.0 * kl_exact_eq14(n)); }
+
 double core_contact_probability(std::uint64_t n, double R, double a) {
   return std::exp(static_cast<double>(n) * std::log1p(-a / (2.0 * R)));
 }

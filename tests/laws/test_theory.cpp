@@ -157,3 +157,33 @@ TEST(Theory, QuenchedDeviationScalesAsOneOverSqrtN) {
 }
 
 }  // namespace
+
+// KL(exact || Eq. 14) per drop, the finite-N correction as a law of N (docs/science-finite-n.md):
+// the quadrature in s = sin^2(theta/2) against the direct integral of f log(f/g) over r_xy, and
+// its large-N law 9/N^2. The direct integral of a 1 % wider Rayleigh differs by far more than the
+// tolerance, so the agreement is not a property of any two nearby laws.
+TEST(Theory, KlOfExactLawFromEq14MatchesTheDirectIntegralAndFallsAs9OverNSquared) {
+  const double R = 3e-3;
+  // At N = 5 the direct integrand has an inverse-square-root singularity at r_xy = R (the exact
+  // density there), which the quadrature resolves to ~3e-4 only; from N = 50 on it is negligible.
+  for (std::uint64_t n : {5ull, 50ull, 1000ull, 10000ull, 100000ull}) {
+    const double kl = kl_exact_eq14(n), direct = kl_exact_eq14_direct(n, R);
+    EXPECT_NEAR(kl, direct, (n < 50 ? 1e-3 : 1e-4) * kl) << "N = " << n;
+    EXPECT_GT(kl, 0) << n;
+  }
+  // Independent of R (the law of s does not involve it).
+  EXPECT_NEAR(kl_exact_eq14_direct(1000, 1.0), kl_exact_eq14(1000), 1e-4 * kl_exact_eq14(1000));
+  for (std::uint64_t n : {100000ull, 1000000ull, 10000000ull}) {
+    const double N = static_cast<double>(n);
+    EXPECT_NEAR(kl_exact_eq14(n) * N * N, 9.0, 60.0 / N) << "N = " << n;  // 9 (1 + O(1/N))
+  }
+  // A wrong second law moves the direct integral by far more than the tolerance above.
+  const Law e = exact_sphere_rxy(1000, R), wide = eq14_rxy(1000, R, 1.01);
+  const double wrong = GK::integrate(
+      [&](double t) { const double a = e.pdf(t), b = wide.pdf(t); return a > 0 && b > 0 ? a * std::log(a / b) : 0.0; },
+      0.0, 2e-3, 15, 1e-12);
+  EXPECT_GT(std::abs(wrong - kl_exact_eq14(1000)), 10.0 * kl_exact_eq14(1000));
+  // Drops for an expected z: z^2 / (2 KL), i.e. ~ z^2 N^2 / 18.
+  EXPECT_NEAR(lr_drops_for_z(10000, 5.0), 25.0 / (2.0 * kl_exact_eq14(10000)), 1e-6);
+  EXPECT_THROW(kl_exact_eq14(1), std::invalid_argument);
+}

@@ -53,6 +53,22 @@ Law exact_sphere_rx(std::uint64_t n, double R);
 /// (on 4000 points up to 12 sigma): the model error of the paper's flat-cap Poisson approximation.
 double model_error_scale(std::uint64_t n, double R);
 
+/// Kullback-Leibler divergence KL(exact || Eq. 14) of r_xy per drop [nats]: the expected log
+/// likelihood ratio of one drop when the exact finite-N law holds, the quantity the likelihood-ratio
+/// test of a streaming run measures. In s = sin^2(theta/2) (r_xy = 2R sqrt(s (1 - s)), monotone on
+/// s <= 1/2) the exact law of the folded s is N (1-s)^(N-1) + N s^(N-1) and Eq. 14's is
+/// N (1 - 2s) exp(-N s (1 - s)) (Eq. 14's mass beyond r_xy = R, exp(-N/4), is not reached by the
+/// exact law and does not enter this direction); the integral over s in [0, 1/2] is done by
+/// Gauss-Kronrod quadrature on pieces of width ~1/N. For large N it is 9/N^2 (1 + O(1/N))
+/// (docs/science-finite-n.md derives it); independent of R. Throws for n < 2.
+double kl_exact_eq14(std::uint64_t n);
+/// The same divergence by direct numerical integration over r_xy of the two laws' densities,
+/// int f_exact log(f_exact / f_eq14) dt (the check of kl_exact_eq14; slower, less accurate for N > 10^6).
+double kl_exact_eq14_direct(std::uint64_t n, double R);
+/// Drops an iid likelihood-ratio test needs for an expected z of the test of Eq. 14 when the exact
+/// law holds: E[z] = 2 KL sqrt(n) / sd, with sd^2 ~ 2 KL for a small divergence, so n = z^2 / (2 KL).
+double lr_drops_for_z(std::uint64_t n, double z);
+
 /// Probability that the bare central sphere touches the plate before any asperity, for a fresh
 /// random sphere: no centre within polar angle theta* of the pole, where
 /// R (1 - cos theta*) = a. Exactly (1 - a/(2R))^N.
