@@ -78,29 +78,36 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
   for (const auto& r : reports)
     for (const auto& g : r.groups) any_theory = any_theory || g.residual_fitted;
   if (any_theory) {
-    std::snprintf(line, sizeof line, "\n%-18s %-13s %-10s %-9s %-19s %-19s %-17s %-8s %-8s %-16s\n", "variant", "group", "res mean",
+    std::snprintf(line, sizeof line, "\n%-18s %-13s %-10s %-9s %-22s %-22s %-17s %-8s %-8s %-16s\n", "variant", "group", "res mean",
                   "res sd", "a fit (theory)", "c fit (theory)", ("[" + scale.substr(1, scale.size() - 2) + "]").c_str(), "KS D",
                   "KS p", "corr(u, res)");
-    o << line << std::string(150, '-') << "\n";
+    o << line << std::string(156, '-') << "\n";
     for (const auto& r : reports)
       for (const auto& g : r.groups) {
         if (!g.residual_fitted) continue;
         const std::string grp = g.by == "speed" ? "u in [" + fmt("%.1f", g.lo) + "," + fmt("%.1f", g.hi) + "]" : "k = " + fmt("%.0f", g.lo);
+        // No nan or inf in the table: an infinite theory rate is a law without that side (at k = 1
+        // the residual has no mass above its mode), a correlation over one speed is not defined.
         auto rate = [&](double fit, double th) {
           std::string x = fmt("%.3f", fit / unit);
-          if (g.has_theory && th > 0) x += " (" + (std::isfinite(th) ? fmt("%.3f", th / unit) : std::string("inf")) + ")";
+          if (g.has_theory && th > 0) x += " (" + (std::isfinite(th) ? fmt("%.3f", th / unit) : std::string("one-sided")) + ")";
           return x;
         };
-        std::snprintf(line, sizeof line, "%-18s %-13s %-10s %-9s %-19s %-19s %-17s %-8s %-8s %-16s\n",
+        const auto& corr = g.speed_residual_correlation;
+        const std::string corr_text = std::isfinite(corr.value) && std::isfinite(corr.se)
+                                          ? fmt("%+.4f", corr.value) + " +- " + fmt("%.4f", corr.se)
+                                          : std::string("not defined");
+        std::snprintf(line, sizeof line, "%-18s %-13s %-10s %-9s %-22s %-22s %-17s %-8s %-8s %-16s\n",
                       std::string(to_string(r.variant)).c_str(), grp.c_str(), fmt("%.3e", g.residual_mean.value).c_str(),
                       fmt("%.2e", g.residual_std).c_str(), rate(g.residual_fit.a.value, g.theory_rate_below).c_str(),
                       rate(g.residual_fit.c.value, g.theory_rate_above).c_str(), "",
                       g.has_theory ? fmt("%.4f", g.theory_ks.D).c_str() : "-", g.has_theory ? fmt("%.2g", g.theory_ks.p).c_str() : "-",
-                      (fmt("%+.4f", g.speed_residual_correlation.value) + " +- " + fmt("%.4f", g.speed_residual_correlation.se)).c_str());
+                      corr_text.c_str());
         o << line;
       }
     o << "res = eps - eps_n(u_k); a, c fit: Eq. 2 fitted to res (no bootstrap); (theory): rates of the semi-analytic law at "
-         "impact k (bounce_residual_laws; paper: with Eq. 26's beta1); KS D, p: res against that law (speed windows: its mixture over k).\n";
+         "impact k (bounce_residual_laws; paper: with Eq. 26's beta1; one-sided: the law has no mass on that side of its mode); "
+         "KS D, p: res against that law (speed windows: its mixture over k); corr(u, res) not defined: one impact speed in the group.\n";
   }
   return detail::checked_text(std::move(o), "report.txt");
 }

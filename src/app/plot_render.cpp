@@ -292,9 +292,9 @@ struct Spans {
   double x = 1, y = 1;
 };
 
-void number_label(PLINT axis, PLFLT value, char* label, PLINT length, PLPointer data) {
-  const auto* s = static_cast<const Spans*>(data);
-  const double span = axis == PL_X_AXIS ? s->x : s->y;
+}  // namespace
+
+std::string tick_text(double value, double span) {
   if (std::abs(value) < 1e-9 * span) value = 0;
   char text[64];
   std::snprintf(text, sizeof text, "%g", value);
@@ -305,6 +305,39 @@ void number_label(PLINT axis, PLFLT value, char* label, PLINT length, PLPointer 
     const int exponent = std::atoi(out.c_str() + e + 1);
     out = (mantissa == "1" ? "" : mantissa == "-1" ? "-" : mantissa + "\xC3\x97") + "10#u" + std::to_string(exponent) + "#d";
   }
+  return out;
+}
+
+YAxisLayout y_axis_layout(double lo, double hi, bool log) {
+  YAxisLayout l;
+  if (log) {  // PLplot's own ticks at the decades, labels 10^k: at most ~4 glyphs wide
+    l.widest = 4, l.title_disp = 4.6;
+    return l;
+  }
+  // A step of 1, 2 or 5 x 10^k giving 4-8 intervals, as PLplot would choose; fixed here so that
+  // every label is known before drawing.
+  const double span = hi - lo, raw = span / 6, mag = std::pow(10.0, std::floor(std::log10(raw))), f = raw / mag;
+  l.step = (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * mag;
+  for (double k = std::ceil(lo / l.step); k * l.step <= hi + 1e-9 * span; k += 1) {
+    std::string t = tick_text(k * l.step, span);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      if (t[i] == '#') { ++i; continue; }             // #u, #d: super/subscript switches, no glyph
+      if ((static_cast<unsigned char>(t[i]) & 0xC0) != 0x80) ++n;  // UTF-8: count lead bytes only
+    }
+    l.widest = std::max(l.widest, n);
+  }
+  // The labels end kTickGap from the axis and are kGlyphWidth per glyph wide; the title's centre
+  // sits half its height plus a gap beyond them.
+  l.title_disp = std::max(4.0, kTickGap + kGlyphWidth * static_cast<double>(l.widest) + 1.0);
+  return l;
+}
+
+namespace {
+
+void number_label(PLINT axis, PLFLT value, char* label, PLINT length, PLPointer data) {
+  const auto* s = static_cast<const Spans*>(data);
+  const std::string out = tick_text(value, axis == PL_X_AXIS ? s->x : s->y);
   std::snprintf(label, static_cast<std::size_t>(length), "%s", out.c_str());
 }
 
@@ -315,6 +348,7 @@ void draw_panel(const Figure& fig, const Panel& p, double vx0, double vx1, doubl
   Axes ax;
   ax.log = p.log_y, ax.log_x = fig.log_x;
   if (ax.log) ax.floor = std::log10(ya) - 1;
+  const YAxisLayout yl = y_axis_layout(ax.y(ya), ax.y(yb), ax.log);
   plvpor(vx0, vx1, vy0, vy1);
   plwind(ax.x(xa), ax.x(xb), ax.y(ya), ax.y(yb));
   if (p.grid) {
@@ -327,10 +361,10 @@ void draw_panel(const Figure& fig, const Panel& p, double vx0, double vx1, doubl
   plcol0(1);
   Spans spans{xb - xa, yb - ya};
   plslabelfunc(number_label, &spans);
-  plbox(ax.log_x ? "bcnstl" : "bcnsto", 0, 0, ax.log ? "bcnstlv" : "bcnstvo", 0, 0);
+  plbox(ax.log_x ? "bcnstl" : "bcnsto", 0, 0, ax.log ? "bcnstlv" : "bcnstvo", yl.step, 0);
   plslabelfunc(nullptr, nullptr);
   plmtex("b", 3.0, 0.5, 0.5, plplot_text(fig.xlabel).c_str());
-  plmtex("l", ax.log ? 4.6 : 5.2, 0.5, 0.5, plplot_text(p.ylabel).c_str());
+  plmtex("l", yl.title_disp, 0.5, 0.5, plplot_text(p.ylabel).c_str());
   draw_legend(p, (vx1 - vx0) * fig.width / fig.resolution_scale, pal);
 }
 
@@ -373,7 +407,19 @@ void draw(const Figure& fig, Palette& pal) {
   plschr(0, kTextScale);
   // Margins in pixels of the scale-1 page (PlotFormats::scale scales page and resolution alike).
   const double px_x = fig.resolution_scale / fig.width, px = fig.resolution_scale / fig.height;
-  const double left = 95.0 * px_x, right = 1 - 30.0 * px_x;
+  // The left margin holds the widest panel's y title (its outer half-height beyond its centre).
+  PLFLT char_mm = 0, ht_mm = 0;
+  plgchr(&char_mm, &ht_mm);
+  const double char_px = ht_mm / 25.4 * 90.0;  // one character height in pixels of the scale-1 page
+  double title_disp = 0;
+  for (const Panel& p : fig.panels) {
+    const auto [ya, yb] = y_range(p);
+    Axes ax;
+    ax.log = p.log_y;
+    if (ax.log) ax.floor = std::log10(ya) - 1;
+    title_disp = std::max(title_disp, y_axis_layout(ax.y(ya), ax.y(yb), ax.log).title_disp);
+  }
+  const double left = std::max(95.0, (title_disp + 0.9) * char_px) * px_x, right = 1 - 30.0 * px_x;
   const double top = 1 - 70.0 * px, bottom = 72.0 * px, gap = 90.0 * px;
   const auto n = static_cast<double>(fig.panels.size());
   const double h = (top - bottom - gap * (n - 1)) / n;

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <exception>
 #include <fstream>
@@ -119,6 +120,37 @@ std::vector<SkippedLaw> sec4_laws(const std::string& reason) {
 // `impact_laws`: the Sec. IV laws describe every drop; when some drops did not impact, the eps
 // sample is truncated and those laws do not apply. `note` collects laws that were not tested,
 // `skipped` lists them.
+namespace {
+
+// A law's name as a figure's legend says it (report.json and the table keep the name): the paper's
+// equation and what was done to it; a name not listed reads "eqNN-x-y" as "Eq. (NN) x y".
+std::string legend_label(const std::string& name) {
+  static const std::pair<const char*, const char*> known[] = {
+      {"eq14", "Eq. (14), Rayleigh"},
+      {"eq18", "Eq. (18), Gaussian"},
+      {"exact-sphere", "exact finite-N law on the sphere"},
+      {"eq28-printed", "Eq. (28) as printed"},
+      {"eq28-paper-route", "Eq. (28) by the paper's route, carried out"},
+      {"eq28-corrected", "Eq. (28) corrected"},
+      {"eq33-printed", "Eq. (33) as printed"},
+      {"eq33-corrected", "Eq. (33) corrected"},
+      {"exact-levels", "exact law over the radius levels"},
+  };
+  for (const auto& [id, text] : known)
+    if (name == id) return text;
+  std::string out = name;
+  for (char& c : out)
+    if (c == '-') c = ' ';
+  if (out.rfind("eq", 0) == 0 && out.size() > 2 && std::isdigit(static_cast<unsigned char>(out[2]))) {
+    const std::size_t end = out.find(' ');
+    out = "Eq. (" + out.substr(2, end == std::string::npos ? std::string::npos : end - 2) + ")" +
+          (end == std::string::npos ? "" : out.substr(end));
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<LawSet> laws_for(const EnsembleConfig& e, bool contact, bool impact_laws, std::string& note,
                              std::vector<SkippedLaw>* skipped = nullptr) {
   const auto& p = e.sphere;
@@ -883,10 +915,7 @@ std::vector<std::string> write_plots(const std::filesystem::path& dir, const Sce
     fig.histogram = make_histogram(x, lo, hi, 60);
     fig.data_label = data_label;
     for (const auto& law : set.laws) {
-      const std::string label = law.name == "eq14"   ? "Eq. (14), Rayleigh"
-                                : law.name == "eq18" ? "Eq. (18), Gaussian"
-                                : law.name == "exact-sphere" ? "exact finite-N law on the sphere"
-                                                             : law.name;
+      const std::string label = legend_label(law.name);
       // r_x and r_y have the same laws on the same range: their curves are computed once (the exact
       // r_x density is a quadrature per point).
       const std::string key = (set.quantity == "r_y" ? std::string("r_x") : set.quantity) + "/" + law.name;

@@ -60,6 +60,7 @@ def make_rough_sphere(
     """N asperity centres uniform on the sphere of radius R, a pure function of (seed, sphere_id)."""
 
 class ContactQuery:
+    """A contact query index over a RoughSphere's centres (RoughSphere.query())."""
     @property
     def backend(self) -> str: ...
     @property
@@ -131,7 +132,8 @@ def eq18_rx(asperities: int, radius: float) -> Law:
 def exact_sphere_rx(asperities: int, radius: float) -> Law:
     """Exact finite-N law of r_x [m] on the sphere."""
 
-def core_contact_probability(asperities: int, radius: float, asperity_radius: float) -> float: ...
+def core_contact_probability(asperities: int, radius: float, asperity_radius: float) -> float:
+    """The probability that a drop's contact is the core sphere rather than an asperity."""
 
 def eq28_printed(asperities: int = 100000, radius: float = 3e-3, asperity_radius: float = 6.5e-7, speed: float = 1.3,
                  omega_x: float = 0.2, omega_y: float = 0.0, beta: float = 0.0467, core_contacts: bool = False) -> Law:
@@ -163,4 +165,6 @@ def cor_table(
     spins: Optional[Sequence[float]] = None,
     omega_bands: int = 0,
 ) -> dict[str, Any]:
-    """A restitution table for DEM codes (app/cor_table.hpp)."""
+    """A restitution table for DEM codes (app/cor_table.hpp): the .json header's keys, with
+    speeds_m_s, probabilities, quantiles (and spins_rad_s, omega_band_quantiles) as arrays; path
+    must end in .csv (asperity.read_cor_table reads it back)."""

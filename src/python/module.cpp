@@ -48,6 +48,29 @@ using Doubles = py::array_t<double, py::array::c_style | py::array::forcecast>;
 // A parameter of the wrong type: TypeError naming it (pybind11's own names no parameter).
 [[noreturn]] void type_error(const std::string& what) { throw py::type_error(what); }
 
+// Signatures in Python's types. pybind11 writes a parameter taken as py::handle/py::object as
+// `handle`/`object` and a class registered later by its C++ name; for those defs it writes no
+// signature (a scoped PythonSignatures) and the docstring begins with the one written here, in the
+// stub's types (src/python/_asperity.pyi; tests/python/test_stubs.py compares the two).
+struct PythonSignatures {
+  py::options options;
+  PythonSignatures() { options.disable_function_signatures(); }
+};
+constexpr const char* kSceneType = "str | os.PathLike[str] | Mapping[str, Any]";
+
+// The library's range checks name the CLI's flags (asperity-radius); Python's parameters are
+// spelled with underscores (asperity_radius).
+template <class F>
+auto python_names(F&& f) {
+  try {
+    return f();
+  } catch (const std::invalid_argument& e) {
+    std::string m = e.what();
+    for (std::size_t i = m.find("asperity-radius"); i != std::string::npos; i = m.find("asperity-radius", i)) m[i + 8] = '_';
+    value_error(m);
+  }
+}
+
 std::string show(const py::handle& h) { return py::repr(h).cast<std::string>(); }
 
 // An array of doubles from `obj`, or TypeError naming the parameter: numpy's own refusal (a string,
@@ -408,11 +431,15 @@ void bind_scenes_and_runs(py::module_& m) {
   m.def("presets", &preset_names, "Names of the built-in preset scenes.");
   m.def("preset_text", [](const std::string& name) { return std::string(preset_text(name)); }, py::arg("name"),
         "The TOML text of a preset scene.");
+  const PythonSignatures signatures;
   m.def("scene_toml", [](const py::handle& scene) { return to_toml(to_scene(scene)); }, py::arg("scene"),
-        "The effective scene (path, preset name or dict) as a format-1 TOML document.");
+        (std::string("scene_toml(scene: ") + kSceneType +
+         ") -> str\n\nThe effective scene (path, preset name or dict) as a format-1 TOML document.").c_str());
   m.def("run", &run, py::arg("scene"), py::arg("progress") = py::none(), py::arg("arrays") = py::none(),
         py::arg("max_array_drops") = std::uint64_t{2000000}, py::arg("out") = py::none(),
-        R"doc(Runs a scene as validate-geometry does and returns report.json as a dict.
+        (std::string("run(scene: ") + kSceneType +
+         ", progress: Callable[[int, int], Any] | None = None, arrays: bool | None = None, max_array_drops: int = 2000000, "
+         "out: str | os.PathLike[str] | bool | None = None) -> dict[str, Any]\n\n" + R"doc(Runs a scene as validate-geometry does and returns report.json as a dict.
 
 scene: a scene file path, a preset name (asperity.presets()) or a dict in the scene-file layout.
 progress: None or a callable progress(done, total), called from this thread now and then.
@@ -424,15 +451,16 @@ out: None (default) writes no file at all (no figures, no checkpoints; a scene w
   files -- outputs.cor_table, body.export_ply -- is refused); a directory path writes the figures and
   the scene's output files there, as the CLI would (the report file is not written: it is the
   return value); True writes them to the scene's outputs.dir.
-The GIL is released while the run computes; Ctrl-C raises KeyboardInterrupt.)doc");
+The GIL is released while the run computes; Ctrl-C raises KeyboardInterrupt.)doc").c_str());
 }
 
 void bind_spheres(py::module_& m) {
+  const PythonSignatures signatures;  // query's signature names ContactQuery, registered later
   py::class_<PySphere, std::shared_ptr<PySphere>>(m, "RoughSphere", "An explicit rough sphere (core/geometry.hpp).")
       .def_property_readonly("asperities", [](const PySphere& s) { return s.body.params.asperities; })
       .def_property_readonly("radius", [](const PySphere& s) { return s.body.params.radius; })
       .def_property_readonly("asperity_radius", [](const PySphere& s) { return s.body.params.asperity_radius; })
-      .def("__len__", [](const PySphere& s) { return s.body.centres.size(); })
+      .def("__len__", [](const PySphere& s) { return s.body.centres.size(); }, "__len__(self: RoughSphere) -> int\n\nN, the number of asperities.")
       .def_property_readonly(
           "centres",
           [](py::object self) {
@@ -459,13 +487,15 @@ void bind_spheres(py::module_& m) {
             q->index = make_contact_query(b, self->body.centres);
             return q;
           },
-          py::arg("backend") = "grid", "A contact query index over the centres (brute, kdtree, cgal, fcl, grid).");
+          py::arg("backend") = "grid",
+          "query(self: RoughSphere, backend: str = 'grid') -> ContactQuery\n\n"
+          "A contact query index over the centres: backend is one of asperity.backends() (brute, kdtree, cgal, fcl, grid).");
   m.def(
       "make_rough_sphere",
       [](std::uint64_t n, double R, double a, std::uint64_t seed, std::uint64_t sphere_id) {
         SphereParams p;
         p.asperities = n, p.radius = R, p.asperity_radius = a;
-        validate(p);
+        python_names([&] { validate(p); });
         check_bytes(sphere_bytes(n, Backend::brute), std::to_string(n) + " asperity centres x 24 B", "asperities");
         auto s = std::make_shared<PySphere>();
         py::gil_scoped_release nogil;
@@ -473,11 +503,17 @@ void bind_spheres(py::module_& m) {
         return s;
       },
       py::arg("asperities") = 100000, py::arg("radius") = 3e-3, py::arg("asperity_radius") = 6.5e-7, py::arg("seed") = 1,
-      py::arg("sphere_id") = 0, "N asperity centres uniform on the sphere of radius R, a pure function of (seed, sphere_id).");
+      py::arg("sphere_id") = 0,
+      "make_rough_sphere(asperities: int = 100000, radius: float = 0.003, asperity_radius: float = 6.5e-07, seed: int = 1, "
+      "sphere_id: int = 0) -> RoughSphere\n\n"
+      "N asperity centres uniform on the sphere of radius R [m], each asperity of radius asperity_radius [m]: a pure "
+      "function of (seed, sphere_id).");
 }
 
 void bind_queries(py::module_& m) {
-  py::class_<PyQuery, std::shared_ptr<PyQuery>>(m, "ContactQuery")
+  const PythonSignatures signatures;
+  py::class_<PyQuery, std::shared_ptr<PyQuery>>(m, "ContactQuery",
+                                                "A contact query index over a RoughSphere's centres (RoughSphere.query()).")
       .def_property_readonly("backend", [](const PyQuery& q) { return std::string(to_string(q.index->backend())); })
       .def_property_readonly("memory_bytes", [](const PyQuery& q) { return q.index->memory_bytes(); })
       .def(
@@ -493,6 +529,7 @@ void bind_queries(py::module_& m) {
             return nearest_to_dict(out, v.single);
           },
           py::arg("d"),
+          "lowest(self: ContactQuery, d: numpy.typing.ArrayLike) -> dict[str, numpy.ndarray]\n\n"
           "The two lowest asperities for unit body-frame down directions d, shape (M, 3) or (3,): dict of index, key, "
           "runner_up, runner_up_key.")
       .def(
@@ -524,13 +561,14 @@ void bind_queries(py::module_& m) {
             return out;
           },
           py::arg("q"),
+          "contact(self: ContactQuery, q: numpy.typing.ArrayLike) -> dict[str, numpy.ndarray]\n\n"
           "World-frame contacts of the body rotated by unit quaternions q = (w, x, y, z), shape (M, 4): dict of index, r "
           "(M, 3) [m], r_xy [m], gap [m], core.");
   m.def("backends", [] {
     std::vector<std::string> v;
     for (const Backend b : all_backends()) v.emplace_back(to_string(b));
     return v;
-  });
+  }, "backends() -> list[str]\n\nThe contact query backends this build has (RoughSphere.query(backend)).");
   m.def(
       "body_down",
       [](const py::handle& qs) {
@@ -540,10 +578,14 @@ void bind_queries(py::module_& m) {
         for (const auto& r : rot) d.push_back(body_down(r));
         return vectors_to_numpy(d, single);
       },
-      py::arg("q"), "The world's down direction in the body frame of bodies rotated by unit quaternions (w, x, y, z).");
+      py::arg("q"),
+      "body_down(q: numpy.typing.ArrayLike) -> numpy.ndarray\n\n"
+      "The world's down direction in the body frame of bodies rotated by unit quaternions q = (w, x, y, z), shape (M, 4) "
+      "or (4,).");
 }
 
 void bind_restitution(py::module_& m) {
+  const PythonSignatures signatures;
   py::class_<Restitution, std::shared_ptr<Restitution>>(m, "Restitution", "A microscopic eps_n(v) model (core/restitution.hpp).")
       .def_property_readonly("name", &Restitution::name)
       .def(
@@ -554,24 +596,27 @@ void bind_restitution(py::module_& m) {
               return (*self)(x);
             }, "v");
           },
-          py::arg("v"), "eps_n at normal contact speeds v >= 0 [m/s] (a number or an array).");
+          py::arg("v"),
+          "__call__(self: Restitution, v: float | numpy.typing.ArrayLike) -> float | numpy.ndarray\n\n"
+          "eps_n at normal contact speeds v >= 0 [m/s] (a number or an array).");
   m.def(
       "pade14",
       [](double beta) -> std::shared_ptr<Restitution> {
         if (!(beta > 0) || !std::isfinite(beta)) value_error("beta = " + std::to_string(beta) + ": must be finite and > 0");
         return viscoelastic_pade14(beta);
       },
-      py::arg("beta") = 0.0467, "Viscoelastic eps_n, Pade [1/4] of Eq. 9.");
+      py::arg("beta") = 0.0467, "pade14(beta: float = 0.0467) -> Restitution\n\nViscoelastic eps_n, Pade [1/4] of Eq. 9.");
   m.def(
       "constant",
       [](double e) -> std::shared_ptr<Restitution> {
         if (!(e >= 0 && e <= 1)) value_error("e = " + std::to_string(e) + ": must be in [0, 1]");
         return constant_restitution(e);
       },
-      py::arg("e"), "eps_n = e at every speed.");
+      py::arg("e"), "constant(e: float) -> Restitution\n\neps_n = e at every speed, e in [0, 1].");
 }
 
 void bind_impulse(py::module_& m) {
+  const PythonSignatures signatures;
   m.def(
       "solve_impact",
       [](double mass, const py::handle& inertia, const py::handle& V, const py::handle& Omega, const py::handle& r,
@@ -633,6 +678,9 @@ void bind_impulse(py::module_& m) {
       },
       py::arg("mass"), py::arg("inertia"), py::arg("V"), py::arg("Omega"), py::arg("r"), py::arg("n") = std::vector<double>{0, 0, 1},
       py::arg("eps_n") = 1.0, py::arg("eps_t") = 1.0,
+      "solve_impact(mass: float, inertia: float | numpy.typing.ArrayLike, V: numpy.typing.ArrayLike, "
+      "Omega: numpy.typing.ArrayLike, r: numpy.typing.ArrayLike, n: numpy.typing.ArrayLike = [0.0, 0.0, 1.0], "
+      "eps_n: float | Restitution = 1.0, eps_t: float = 1.0) -> dict[str, Any]\n\n"
       R"doc(Impulse solve of Eq. 7 (core/impact.hpp) over arrays: V, Omega, r, n of shape (M, 3) or (3,)
 (broadcast); inertia a number (J = inertia x identity) or a 3x3 world-frame tensor; eps_n a number or
 a model (asperity.pade14()). Returns a dict of P, V_after, Omega_after, eps, eps_n, v_n, impact; rows
@@ -640,13 +688,17 @@ without an impact (v_n >= 0) are NaN with impact False.)doc");
 }
 
 void bind_laws(py::module_& m) {
+  std::optional<PythonSignatures> signatures(std::in_place);  // pdf, cdf take a number or an array
   py::class_<Law>(m, "Law", "A one-dimensional law with pdf and cdf (laws/theory.hpp).")
       .def_readonly("name", &Law::name)
       .def_readonly("description", &Law::description)
       .def_readonly("mean", &Law::mean)
-      .def("pdf", [](const Law& l, const py::handle& x) { return elementwise(x, [&](double t) { return l.pdf(t); }); }, py::arg("x"))
-      .def("cdf", [](const Law& l, const py::handle& x) { return elementwise(x, [&](double t) { return l.cdf(t); }); }, py::arg("x"))
+      .def("pdf", [](const Law& l, const py::handle& x) { return elementwise(x, [&](double t) { return l.pdf(t); }); }, py::arg("x"),
+           "pdf(self: Law, x: float | numpy.typing.ArrayLike) -> float | numpy.ndarray\n\nThe probability density at x.")
+      .def("cdf", [](const Law& l, const py::handle& x) { return elementwise(x, [&](double t) { return l.cdf(t); }); }, py::arg("x"),
+           "cdf(self: Law, x: float | numpy.typing.ArrayLike) -> float | numpy.ndarray\n\nThe cumulative distribution at x.")
       .def("__repr__", [](const Law& l) { return "<asperity.Law " + l.name + ": " + l.description + ">"; });
+  signatures.reset();
   auto check_nr = [](std::uint64_t n, double R) {
     check_asperity_count(n, "asperities");
     if (!(R > 0) || !std::isfinite(R)) value_error("radius = " + std::to_string(R) + ": must be finite and > 0");
@@ -659,8 +711,16 @@ void bind_laws(py::module_& m) {
         "Eq. 18: law of r_x [m] (Normal).");
   m.def("exact_sphere_rx", [=](std::uint64_t n, double R) { check_nr(n, R); return exact_sphere_rx(n, R); }, py::arg("asperities"),
         py::arg("radius"), "Exact finite-N law of r_x [m] on the sphere.");
-  m.def("core_contact_probability", [=](std::uint64_t n, double R, double a) { check_nr(n, R); return core_contact_probability(n, R, a); },
-        py::arg("asperities"), py::arg("radius"), py::arg("asperity_radius"));
+  m.def(
+      "core_contact_probability",
+      [=](std::uint64_t n, double R, double a) {
+        check_nr(n, R);
+        if (!(a > 0) || !(a < R)) value_error("asperity_radius = " + std::to_string(a) + ": must be > 0 and < radius");
+        return core_contact_probability(n, R, a);
+      },
+      py::arg("asperities"), py::arg("radius"), py::arg("asperity_radius"),
+      "The probability that a drop's contact is the core sphere rather than an asperity (N asperities of radius "
+      "asperity_radius [m] on a sphere of radius [m]).");
 #define ASPERITY_IMPACT_LAW(fn, doc)                                                                                        \
   m.def(                                                                                                                    \
       #fn,                                                                                                                  \
@@ -680,6 +740,7 @@ void bind_laws(py::module_& m) {
 }
 
 void bind_tables(py::module_& m) {
+  const PythonSignatures signatures;
   m.def(
       "cor_table",
       [](const py::handle& scene, const py::object& speeds, std::size_t probabilities, const py::object& drops,
@@ -709,7 +770,11 @@ void bind_tables(py::module_& m) {
                     std::to_string(spec.drops) + " drops per speed, " + std::to_string(spec.probabilities) + " probabilities x " +
                         std::to_string(spec.speeds.size()) + " speeds",
                     "drops, probabilities, speeds, spins or omega_bands");
+        if (!path.is_none() && !py::isinstance<py::str>(path) && !py::hasattr(path, "__fspath__"))
+          type_error("path: expected None or a file path ending in .csv, got " + show(path));
         const std::string file = path.is_none() ? std::string() : py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        if (!file.empty() && std::filesystem::path(file).extension() != ".csv")
+          value_error("path = '" + file + "': must end in .csv (its header is written beside it as .json)");
         const Progress p = python_progress(progress);
         CorTable t;
         std::vector<std::filesystem::path> files;
@@ -720,9 +785,11 @@ void bind_tables(py::module_& m) {
         }
         std::vector<double> q;
         for (const auto& row : t.rows) q.insert(q.end(), row.quantiles.begin(), row.quantiles.end());
+        // The .json header's keys, once each; its grids as arrays (speeds_m_s, probabilities, spins_rad_s).
         py::dict out = py::module_::import("json").attr("loads")(cor_table_json(t));
-        out["speeds"] = to_numpy(std::vector<double>(spec.speeds));
-        out["p"] = to_numpy(std::vector<double>(t.probabilities));
+        out["speeds_m_s"] = to_numpy(std::vector<double>(spec.speeds));
+        out["probabilities"] = to_numpy(std::vector<double>(t.probabilities));
+        if (out.contains("spins_rad_s")) out["spins_rad_s"] = to_numpy(out["spins_rad_s"].cast<std::vector<double>>());
         const auto P = static_cast<py::ssize_t>(t.probabilities.size()), S = static_cast<py::ssize_t>(spec.speeds.size());
         if (t.format() == 1) {
           out["quantiles"] = to_numpy(std::move(q)).reshape({S, P});
@@ -742,15 +809,21 @@ void bind_tables(py::module_& m) {
       py::arg("scene") = "fig4", py::arg("speeds") = py::none(), py::arg("probabilities") = 201, py::arg("drops") = py::none(),
       py::arg("path") = py::none(), py::arg("progress") = py::none(), py::arg("spins") = py::none(),
       py::arg("omega_bands") = 0,
-      R"doc(A restitution table for DEM codes (app/cor_table.hpp; docs/dem-tables.md).
+      (std::string("cor_table(scene: ") + kSceneType +
+       " = 'fig4', speeds: Sequence[float] | None = None, probabilities: int = 201, drops: int | None = None, "
+       "path: str | os.PathLike[str] | None = None, progress: Callable[[int, int], Any] | None = None, "
+       "spins: Sequence[float] | None = None, omega_bands: int = 0) -> dict[str, Any]\n\n" +
+       R"doc(A restitution table for DEM codes (app/cor_table.hpp; docs/dem-tables.md).
 
 The sphere, material, spin and seed come from `scene` (a sphere impact scene); speeds [m/s]
 default to 9 points from u/10 to 10 u around its impact speed u; drops per speed (sampled from the exact law of the lowest asperity)
-default to 1e5. Returns the JSON header as a dict plus arrays speeds, p, quantiles (speeds x p);
-with path, writes path (CSV) and the .json next to it (files lists them). spins [rad/s] (incoming
+default to 1e5. Returns the table's .json header as a dict, its grids speeds_m_s and
+probabilities as arrays, plus quantiles (speeds x probabilities); with path (ending in .csv),
+writes the CSV and the .json next to it (files lists them; asperity.read_cor_table reads them back). spins [rad/s] (incoming
 Omega = (spin, 0, 0)) and/or omega_bands (Omega'_x quantiles per eps band, for joint draws) make a
 format-2 table: quantiles then has shape (spins, speeds, p) and omega_band_quantiles
-(spins, speeds, bands, p).)doc");
+(spins, speeds, bands, p).)doc")
+          .c_str());
 }
 
 }  // namespace

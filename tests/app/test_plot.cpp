@@ -302,3 +302,29 @@ TEST(Plot, InvalidFiguresAreRejected) {
   }
   EXPECT_FALSE(fs::exists(png));
 }
+
+// Issue 32: Fig. 4's eps.png had its y title overprinted by 5-digit tick labels (the title sat at a
+// fixed 5.2 character heights). The layout rule: the title's centre lies beyond the widest label's
+// far end (kTickGap + kGlyphWidth per glyph, measured on the PNGs: a digit is 0.88 character
+// heights wide) by at least half a character height plus a gap, for every range a figure of the
+// presets draws (probability densities up to 3e4, eps near 0.945, spins in rad/s, 1e-6 scales).
+TEST(PlotLayout, YTitleClearsTheWidestTickLabel) {
+  using asperity::detail::y_axis_layout;
+  const std::pair<double, double> ranges[] = {{0, 30000}, {0, 21000}, {0, 1.5}, {0.9447, 0.9453}, {-6, 6},
+                                              {0, 2e6},   {0, 1e-4},  {-3e-6, 3e-6}, {0, 0.012}, {100, 130000}};
+  for (const auto& [lo, hi] : ranges) {
+    const auto l = y_axis_layout(lo, hi, false);
+    ASSERT_GT(l.step, 0) << lo << " " << hi;
+    const double intervals = (hi - lo) / l.step;
+    EXPECT_GE(intervals, 2.5) << lo << " " << hi;
+    EXPECT_LE(intervals, 12.5) << lo << " " << hi;
+    const double label_end = asperity::detail::kTickGap + 0.88 * static_cast<double>(l.widest);
+    EXPECT_GE(l.title_disp - 0.5, label_end + 0.3) << "range [" << lo << ", " << hi << "]: labels of " << l.widest
+                                                   << " glyphs reach " << label_end << ", the title starts at "
+                                                   << l.title_disp - 0.5;
+  }
+  // The rule has teeth: 30000 has 5 glyphs, and the old fixed 5.2 does not clear them.
+  const auto l = y_axis_layout(0, 30000, false);
+  EXPECT_EQ(l.widest, 5u);
+  EXPECT_LT(5.2 - 0.5, asperity::detail::kTickGap + 0.88 * 5 + 0.3);
+}

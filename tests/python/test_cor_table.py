@@ -21,7 +21,9 @@ def test_table_quantiles_and_header(tmp_path):
     t = small(path=path)
     assert t["quantiles"].shape == (3, 11)
     assert np.all(np.diff(t["quantiles"], axis=1) >= 0)
-    np.testing.assert_allclose(t["p"], np.linspace(0, 1, 11), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(t["probabilities"], np.linspace(0, 1, 11), rtol=0, atol=1e-15)
+    np.testing.assert_array_equal(t["speeds_m_s"], [0.5, 1.0, 2.0])
+    assert "p" not in t and "speeds" not in t  # one name per field: the .json header's
     assert t["format_version"] == 1 and t["body"]["N"] == 100000
     assert len(t["rows"]) == 3 and all("m" in r["eq2_fit"] for r in t["rows"])
     # the spin after the impact: its marginal quantiles on the same grid, centred on Omega_x = 0.2
@@ -75,7 +77,7 @@ def test_c_header_reads_the_table(tmp_path):
 def test_spin_grid_and_omega_bands(tmp_path):
     path = tmp_path / "spins.csv"
     t = small(spins=[-1.0, 0.0, 1.0], omega_bands=5, path=path)
-    assert t["format_version"] == 2 and t["spins_rad_s"] == [-1.0, 0.0, 1.0]
+    assert t["format_version"] == 2 and list(t["spins_rad_s"]) == [-1.0, 0.0, 1.0]
     assert t["quantiles"].shape == (3, 3, 11)
     assert t["omega_band_quantiles"].shape == (3, 3, 5, 11)
     lines = [l for l in path.read_text().splitlines() if not l.startswith("#")]
@@ -85,3 +87,26 @@ def test_spin_grid_and_omega_bands(tmp_path):
         small(spins=[1.0, -1.0])
     with pytest.raises(ValueError, match="omega_bands"):
         small(omega_bands=5000)
+
+
+def test_read_cor_table_returns_what_was_written(tmp_path):
+    """read_cor_table(path) gives back cor_table()'s dict: the same keys, the same arrays bit for bit."""
+    for kw in (dict(), dict(spins=[-1.0, 0.0, 1.0], omega_bands=3)):
+        path = tmp_path / f"t{len(kw)}.csv"
+        t = small(path=path, **kw)
+        r = asperity.read_cor_table(path)
+        assert set(r) == set(t) - {"files"}
+        for key in ("speeds_m_s", "probabilities", "quantiles", "spins_rad_s", "omega_band_quantiles"):
+            if key in t:
+                assert isinstance(r[key], np.ndarray), key
+                np.testing.assert_array_equal(r[key], t[key], err_msg=key)
+        assert r["rows"] == t["rows"] and r["format_version"] == t["format_version"]
+
+
+def test_read_cor_table_refuses_a_truncated_table(tmp_path):
+    path = tmp_path / "t.csv"
+    small(path=path)
+    text = path.read_text().splitlines()
+    path.write_text("\n".join(text[:-1]) + "\n")  # the last speed's row lost
+    with pytest.raises(ValueError, match="speeds=3"):
+        asperity.read_cor_table(path)

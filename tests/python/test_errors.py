@@ -73,6 +73,13 @@ CASES = [
     ("asperity.make_rough_sphere(100, radius=float('nan'))", "ValueError", "radius"),
     ("asperity.make_rough_sphere(100, radius=-1.0)", "ValueError", "radius"),
     ("asperity.make_rough_sphere(100, seed=2**70)", "ValueError", "seed"),
+    # the Python parameter's name, not the CLI flag's (asperity-radius)
+    ("asperity.make_rough_sphere(100, asperity_radius=-1.0)", "ValueError", "asperity_radius"),
+    ("asperity.make_rough_sphere(100, asperity_radius=1e-20)", "ValueError", "asperity_radius"),
+    ("asperity.core_contact_probability(10, 1e-3, -1.0)", "ValueError", "asperity_radius"),
+    ("asperity.cor_table(drops=100, speeds=[1.0], probabilities=3, path='t.txt')", "ValueError", ".csv"),
+    ("asperity.cor_table(path=5)", "TypeError", "path"),
+    ("asperity.read_cor_table('t.txt')", "ValueError", ".csv"),
     ("asperity.pade14(float('nan'))", "ValueError", "beta"),
     ("asperity.pade14()(-1.0)", "ValueError", "v"),
     ("asperity.constant(-0.5)", "ValueError", "e"),

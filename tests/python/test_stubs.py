@@ -67,3 +67,34 @@ def test_a_wrong_stub_is_caught():
     fn = next(n for n in stub_tree().body if isinstance(n, ast.FunctionDef) and n.name == "eq14_rxy")
     fn.args.args[0].arg = "n"
     assert pybind_parameters(mod.eq14_rxy) != stub_parameters(fn)
+
+
+def test_signatures_are_python_types():
+    """Every signature line (help() shows it first) in Python's types: none of pybind11's internals
+    (`handle`, `object` for a parameter, a C++ class name) -- issue 32."""
+    import asperity
+    bad = re.compile(r"\bhandle\b|: object\b|-> object\b|::|anonymous namespace|std::")
+    seen = 0
+    for name in asperity.__all__:
+        obj = getattr(asperity, name)
+        fns = [obj] if callable(obj) and not isinstance(obj, type) else \
+              [f for n, f in vars(obj).items() if callable(f) and (not n.startswith("__") or n in ("__call__", "__len__"))] \
+              if isinstance(obj, type) else []
+        for fn in fns:
+            first = (getattr(fn, "__doc__", None) or "").splitlines()[:1]
+            assert first and "(" in first[0], f"{name}: no signature line"
+            assert not bad.search(first[0]), f"{name}: {first[0]}"
+            seen += 1
+    assert seen > 25
+    # the check has teeth: pybind11's own line for a py::handle parameter is caught
+    assert bad.search("run(scene: handle, progress: object = None) -> object")
+
+
+def test_help_lists_the_api():
+    import pydoc
+    import asperity
+    text = pydoc.render_doc(asperity, renderer=pydoc.plaintext)
+    for name in ("run", "make_rough_sphere", "cor_table", "read_cor_table", "RoughSphere", "ContactQuery", "Law"):
+        assert name in asperity.__all__, name
+        assert f"\n    {name}(" in text or f"class {name}" in text, f"help(asperity) does not list {name}"
+    assert "scene: str | os.PathLike[str] | Mapping[str, Any]" in pydoc.render_doc(asperity.run, renderer=pydoc.plaintext)

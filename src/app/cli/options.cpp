@@ -148,7 +148,7 @@ struct RawOptions {
 
 void add_options(CLI::App& app, RawOptions& r) {
   auto* preset_opt = app.add_option("--preset", r.preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
-  app.add_option("--scene", r.scene_file, "scene file (TOML, see README \"Scenes\"); the options below override it")
+  app.add_option("--scene", r.scene_file, "scene file (TOML, see docs/scenes.md); the options below override it")
       ->excludes(preset_opt);
   app.add_option("--asperities,-N", r.asperities, "number of asperities N (>= 1)");
   app.add_option("--radius", r.radius, "central sphere radius R [m]");
