@@ -1,0 +1,33 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+# ctest symbols.foreign: each shared library exports fewer than LIMIT dynamic symbols that are not
+# asperity's (cmake/asperity.map). Usage: cmake -DNM=nm -DLIMIT=40 -DLIBS="a.so;b.so" -P check_symbols.cmake
+# A library built without the export list (symbols.foreign.power) must fail it: the check can fail.
+foreach(lib IN LISTS LIBS)
+  execute_process(COMMAND ${NM} -D -C --defined-only ${lib} OUTPUT_VARIABLE out RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "${NM} failed on ${lib}")
+  endif()
+  string(REPLACE "\n" ";" lines "${out}")
+  set(foreign 0)
+  set(examples "")
+  foreach(line IN LISTS lines)
+    # "ADDRESS TYPE NAME": skip absolute/version nodes (A) and asperity's own names.
+    if(line MATCHES "^[0-9a-f]+ ([A-Za-z]) (.*)$")
+      set(type "${CMAKE_MATCH_1}")
+      set(name "${CMAKE_MATCH_2}")
+      if(type STREQUAL "A" OR name MATCHES "asperity" OR name MATCHES "^_(init|fini)$")
+        continue()
+      endif()
+      math(EXPR foreign "${foreign} + 1")
+      list(LENGTH examples n)
+      if(n LESS 5)
+        list(APPEND examples "${name}")
+      endif()
+    endif()
+  endforeach()
+  message(STATUS "${lib}: ${foreign} foreign symbols exported")
+  if(NOT foreign LESS LIMIT)
+    string(REPLACE ";" "\n  " shown "${examples}")
+    message(FATAL_ERROR "${lib} exports ${foreign} symbols that are not asperity's (limit ${LIMIT}), e.g.\n  ${shown}")
+  endif()
+endforeach()
