@@ -339,6 +339,18 @@ TEST(GridWinners, NearTiesBelowFloatResolution) {
   for (std::size_t n : {1u, 7u, 255u}) EXPECT_EQ(check(*g, c, std::span<const Vec3>(q).first(n)), 0);
 }
 
+// Stress grids: 0.1-0.5 centres per cell, so the 3x3 window often holds a point while the nearest
+// centre lies outside it: the winners path must then refuse the guard's certificate and widen
+// (plane bound, full search, brute force). A guard 100x too large fails here (checked by hand).
+TEST(GridWinners, SparseCellsForceTheFallbacks) {
+  const auto c = sphere(2000, 95);
+  const auto d = directions(5000, 96);
+  for (int side : {30, 40, 60}) {
+    const auto q = asperity::detail::make_grid_with(c, side, 0.2);
+    EXPECT_EQ(check(*q, c, d), 0) << "side " << side;
+  }
+}
+
 // ---- (d) single vs batch ------------------------------------------------------------------------
 
 TEST(Grid, BatchEqualsSingle) {
