@@ -345,7 +345,7 @@ using Answers = std::vector<std::pair<Vec3, Nearest>>;
 void rotate(const EnsembleConfig& c, const detail::CheckPlan& plan, const RoughSphere& body, const ContactQuery& index,
             std::uint64_t k, std::uint64_t b, std::uint64_t e, Answers* checks, ContactSamples& s) {
   const std::uint64_t m = c.drops / c.spheres;
-  detail::query_drops(c, m, body.centres, index, k, b, e,
+  detail::query_drops(c, m, body.centres, index, k, b, e, detail::Answers::full,
                           [&](std::uint64_t j, const Contact& contact, const Vec3& down, const Nearest& r) {
                             store(s, k * m + j, contact);
                             if (checks && j % plan.stride == 0 && checks->size() < plan.per_sphere)

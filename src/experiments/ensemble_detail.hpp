@@ -27,11 +27,14 @@ inline Vec3 drop_direction(const EnsembleConfig& c, std::uint64_t drop) { return
 /// kernel (c.kernel: scalar or simd, the same bits). The one definition of an explicit drop, so
 /// that both drivers see the same drops. `each(j, contact, down, nearest)` per drop, in order of j.
 /// Batches of kQueryBatch drops: their buffers (~40 KiB) stay in L1/L2 next to the index and the
-/// histograms (answers do not depend on the batching).
+/// histograms (answers do not depend on the batching). Answers::winners: the lowest asperity only
+/// (ContactQuery::lowest_winners; the contacts' gap is then +inf), for statistics that need no
+/// runner-up; Answers::full: the runner-up too (raw samples report the gap).
+enum class Answers { full, winners };
 inline constexpr std::uint64_t kQueryBatch = 256;
 template <class Each>
 void query_drops(const EnsembleConfig& c, std::uint64_t m, std::span<const Vec3> centres, const ContactQuery& index,
-                 std::uint64_t k, std::uint64_t b, std::uint64_t e, Each&& each) {
+                 std::uint64_t k, std::uint64_t b, std::uint64_t e, Answers answers, Each&& each) {
   std::array<Vec3, kQueryBatch> d;
   std::array<double, kQueryBatch> cs, sn;
   std::array<Nearest, kQueryBatch> nn;
@@ -40,7 +43,8 @@ void query_drops(const EnsembleConfig& c, std::uint64_t m, std::span<const Vec3>
     const std::size_t n = static_cast<std::size_t>(std::min(kQueryBatch, e - lo));
     const std::span<Vec3> dn(d.data(), n);
     draw_drops(c.kernel, c.seed, k * m + lo, dn, std::span<double>(cs.data(), n), std::span<double>(sn.data(), n));
-    index.lowest(dn, std::span<Nearest>(nn.data(), n));
+    if (answers == Answers::winners) index.lowest_winners(dn, std::span<Nearest>(nn.data(), n));
+    else index.lowest(dn, std::span<Nearest>(nn.data(), n));
     drop_contacts(c.kernel, dn, std::span<const double>(cs.data(), n), std::span<const double>(sn.data(), n),
                   std::span<const Nearest>(nn.data(), n), centres, c.sphere.radius, c.sphere.asperity_radius,
                   std::span<Contact>(ct.data(), n));

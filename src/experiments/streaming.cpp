@@ -152,7 +152,7 @@ struct Driver {
   void explicit_unit(const Built& b, std::uint64_t k, std::uint64_t j, int t, Slot& slot) const {
     const std::uint64_t lo = j * kUnit, hi = std::min(m, lo + kUnit);
     const std::size_t g = sink.block(k);
-    detail::query_drops(c, m, b.body.centres, *b.index, k, lo, hi,
+    detail::query_drops(c, m, b.body.centres, *b.index, k, lo, hi, detail::Answers::winners,
                             [&](std::uint64_t, const Contact& contact, const Vec3&, const Nearest&) {
                               sink.count(t, g, contact, slot);
                             });
@@ -169,12 +169,17 @@ struct Driver {
   }
 
   // The run's queries of a checked sphere (rotations j % stride == 0, the first per_sphere), asked
-  // again of its index (deterministic: the answers the run uses) and of the other backends.
+  // again of its index (deterministic: the answers the run uses) and of the other backends. The
+  // run uses the winners path (lowest_winners): its winner with the full path's runner-up is what
+  // the other backends must answer.
   detail::SphereCheck check(const Built& b, std::uint64_t k) const {
     std::vector<std::pair<Vec3, Nearest>> answers;
     for (std::uint64_t r = 0; r < m && answers.size() < plan.per_sphere; r += plan.stride) {
       const Vec3 d = detail::drop_direction(c, k * m + r);
-      answers.emplace_back(d, b.index->lowest(d));
+      Nearest full = b.index->lowest(d), win;
+      b.index->lowest_winners(std::span<const Vec3>(&d, 1), std::span<Nearest>(&win, 1));
+      full.index = win.index, full.key = win.key;
+      answers.emplace_back(d, full);
     }
     return detail::cross_check_sphere(c, b.body.centres, answers, plan.others, k);
   }

@@ -68,10 +68,12 @@ std::vector<Vec3> special_directions() {
   return d;
 }
 
-/// Checks every query of the single and the batch API against the reference; returns mismatches.
+/// Checks every query of the single and the batch API, and the winners-only batch (float kernel,
+/// guard, fallbacks), against the reference; returns mismatches.
 int check(const asperity::ContactQuery& q, std::span<const Vec3> c, std::span<const Vec3> d) {
-  std::vector<Nearest> batch(d.size()), ref(d.size());
+  std::vector<Nearest> batch(d.size()), ref(d.size()), win(d.size());
   q.lowest(d, batch);
+  q.lowest_winners(d, win);
   // The reference scans dominate the test time: spread them over the cores.
   const auto nq = static_cast<std::int64_t>(d.size());
 #pragma omp parallel for schedule(dynamic, 16)
@@ -84,7 +86,8 @@ int check(const asperity::ContactQuery& q, std::span<const Vec3> c, std::span<co
     const Nearest one = q.lowest(d[k]);
     EXPECT_EQ(one, ref[k]) << "query " << k << " d = (" << d[k].transpose() << ")";
     EXPECT_EQ(batch[k], one) << "batch query " << k;
-    if (!(one == ref[k]) || !(batch[k] == one)) ++bad;
+    EXPECT_EQ(win[k], asperity::winner_only(ref[k])) << "winners query " << k << " d = (" << d[k].transpose() << ")";
+    if (!(one == ref[k]) || !(batch[k] == one) || !(win[k] == asperity::winner_only(ref[k]))) ++bad;
     if (bad > 10) {
       ADD_FAILURE() << "too many mismatches, stopping";
       break;
@@ -302,6 +305,50 @@ TEST(Grid, NonUnitInputsFallBackToTheReference) {
   for (const auto& v : d) odd.push_back(1.5 * v);
   odd.push_back(Vec3(0, 0, 0));
   EXPECT_EQ(check(*q, c, odd), 0);
+}
+
+// ---- winners only: near-ties below float resolution ---------------------------------------------
+
+// Clusters of 2-7 centres around random directions, spread by 1e-9 .. 1e-6 rad (far below what a
+// float key resolves at N = 10^4), some of them exact copies (key ties: the lowest index wins), on a
+// random background sphere; queried at the cluster's direction and just beside it. Every answer
+// of the winners path (float keys, FP64 recheck, guard, plane bound, fallback) equals brute force.
+TEST(GridWinners, NearTiesBelowFloatResolution) {
+  auto c = sphere(10000, 91);
+  const auto centre = directions(300, 92);
+  std::vector<Vec3> q;
+  for (std::size_t k = 0; k < centre.size(); ++k) {
+    asperity::Stream s(93, asperity::Purpose::test, k);
+    const Vec3 a = centre[k];
+    const Vec3 t1 = a.unitOrthogonal(), t2 = a.cross(t1);
+    const double spread = std::pow(10.0, -9.0 + 3.0 * s.uniform0());
+    const auto members = 2 + static_cast<std::size_t>(6.0 * s.uniform0());
+    for (std::size_t i = 0; i < members; ++i) {
+      const double e1 = spread * (2.0 * s.uniform0() - 1.0), e2 = spread * (2.0 * s.uniform0() - 1.0);
+      const Vec3 p = (a + e1 * t1 + e2 * t2).normalized();
+      const std::size_t at = static_cast<std::size_t>(s.uniform0() * double(c.size()));
+      c[at] = p;
+      if (i == 0 && k % 3 == 0) c[(at + 4999) % c.size()] = p;  // an exact copy: a key tie
+    }
+    q.push_back(a);
+    q.push_back((a + 0.5 * spread * t1).normalized());
+  }
+  const auto g = grid(c);
+  EXPECT_EQ(check(*g, c, q), 0);
+  // The batch tail: sizes that are not multiples of anything.
+  for (std::size_t n : {1u, 7u, 255u}) EXPECT_EQ(check(*g, c, std::span<const Vec3>(q).first(n)), 0);
+}
+
+// Stress grids: 0.1-0.5 centres per cell, so the 3x3 window often holds a point while the nearest
+// centre lies outside it: the winners path must then refuse the guard's certificate and widen
+// (plane bound, full search, brute force). A guard 100x too large fails here (checked by hand).
+TEST(GridWinners, SparseCellsForceTheFallbacks) {
+  const auto c = sphere(2000, 95);
+  const auto d = directions(5000, 96);
+  for (int side : {30, 40, 60}) {
+    const auto q = asperity::detail::make_grid_with(c, side, 0.2);
+    EXPECT_EQ(check(*q, c, d), 0) << "side " << side;
+  }
 }
 
 // ---- (d) single vs batch ------------------------------------------------------------------------

@@ -66,6 +66,11 @@ class ContactQuery {
   virtual Nearest lowest(const Vec3& d) const = 0;
   /// Many queries at once; backends may overlap their memory latency across the batch.
   virtual void lowest(std::span<const Vec3> d, std::span<Nearest> out) const;
+  /// The lowest asperity only, for many queries (streaming statistics need no runner-up):
+  /// out[i].index and out[i].key are lowest(d[i])'s bit for bit; the runner-up is not computed,
+  /// out[i].runner_up = out[i].index and out[i].runner_up_key = +inf, whichever backend answers.
+  /// A backend may certify the winner alone, which is cheaper than certifying the runner-up.
+  virtual void lowest_winners(std::span<const Vec3> d, std::span<Nearest> out) const;
   /// Bytes held by the index, beyond the caller's centres.
   virtual std::size_t memory_bytes() const = 0;
 };
@@ -75,6 +80,11 @@ std::unique_ptr<ContactQuery> make_contact_query(Backend backend, std::span<cons
 
 /// Reference scan: the two smallest (key, index) pairs over all centres.
 Nearest brute_lowest(std::span<const Vec3> centres, const Vec3& d);
+
+/// A full answer reduced to what lowest_winners reports: the winner, no runner-up (+inf).
+inline Nearest winner_only(const Nearest& n) noexcept {
+  return Nearest{n.index, n.key, n.index, std::numeric_limits<double>::infinity()};
+}
 
 /// The physical contact of a body with the plate, in the WORLD frame (z up, plate below).
 struct Contact {

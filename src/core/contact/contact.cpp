@@ -45,6 +45,11 @@ void ContactQuery::lowest(std::span<const Vec3> d, std::span<Nearest> out) const
   for (std::size_t i = 0; i < d.size(); ++i) out[i] = lowest(d[i]);
 }
 
+void ContactQuery::lowest_winners(std::span<const Vec3> d, std::span<Nearest> out) const {
+  lowest(d, out);  // checks the sizes
+  for (Nearest& n : out) n = winner_only(n);
+}
+
 std::unique_ptr<ContactQuery> make_contact_query(Backend backend, std::span<const Vec3> centres) {
   if (centres.empty()) throw std::invalid_argument("make_contact_query: a body needs at least one asperity");
   switch (backend) {

@@ -90,7 +90,8 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 // then take the general path. Measured best among kRowSlots 8/12/16 x kPerCell 1.0..2.5.
 constexpr int kRowSlots = 8;
 constexpr double kPerCell = 1.3;
-constexpr std::size_t kPad = kRowSlots + 4;  // readable slots past the last point
+constexpr std::size_t kPad = kRowSlots + 4;  // readable slots past the last point (records and float rows)
+static_assert(kRowSlots == 8, "window_winner reads one 8-lane float vector per run");
 constexpr std::size_t kResidentBytes = std::size_t{1} << 20;  // batched queries without prefetch up to this
 
 /// Allocator for the big arrays: 2 MiB-aligned and, on Linux, backed by transparent huge pages
@@ -240,6 +241,72 @@ TopPair top_pair(const Pt* pts, const Runs& runs, double dx, double dy, double d
   }
   return {m1, m2, static_cast<std::uint32_t>(e1[0]), static_cast<std::uint32_t>(e2[0]), true};
 }
+
+// ---- winner-only kernel (lowest_winners) --------------------------------------------------------
+// The 3x3 window's winner from float32 copies of the coordinates (SoA rows: one 8-lane vector per
+// run of three cells), with every candidate that could be the FP64 winner rechecked in FP64 by
+// contact_key's expression. Float error bound (u = 2^-24, inputs |p_i|, |d_i| <= 1 + 1e-12): the
+// float coordinates err by <= u |p_i| each, the float difference by another u, so the float vector
+// delta' differs from the true delta by <= sqrt(3) (2u + 2u^2) + u |delta| (Euclidean), and the float
+// sum of squares is |delta'|^2 (1 + eta), |eta| <= 3u / (1 - 3u) (underflow adds < 2^-147). Hence a
+// point of float key m has true distance <= (sqrt(m) (1 + 4u) + 4u) and the true winner, no farther
+// than that point, has float key <= ((1 + 4u) true distance + 4u)^2 (1 + 4u). Candidates: float key
+// <= T(m) = ((1 + 1e-6) sqrt(m) + 8u)^2 (1 + 1e-6), which is above that (the FP64 keys differ from
+// the true ones by ~1e-16 relative), so every point whose FP64 key equals the window's smallest is
+// rechecked, and ties go to the lowest index as in brute_lowest.
+using v8f = float __attribute__((vector_size(32)));
+using v8i = std::int32_t __attribute__((vector_size(32)));
+
+struct Win {
+  double key;
+  std::uint32_t id;
+};
+
+/// The threshold T(m) above (double, then rounded up to a float by the extra 1e-6).
+inline float candidate_bound(float m) noexcept {
+  constexpr double u8 = 8.0 * 0x1p-24;
+  const double r = (1.0 + 1e-6) * __builtin_sqrt(static_cast<double>(m)) + u8;
+  return static_cast<float>(r * r * (1.0 + 2e-6));
+}
+
+ASPERITY_GRID_CLONES
+Win window_winner(const float* fx, const float* fy, const float* fz, const Pt* pts, const Runs& runs, double dx, double dy,
+                  double dz) noexcept {
+  const float fdx = static_cast<float>(dx), fdy = static_cast<float>(dy), fdz = static_cast<float>(dz);
+  const v8f INF = v8f{} + std::numeric_limits<float>::infinity();
+  const v8i lane = {0, 1, 2, 3, 4, 5, 6, 7};
+  v8f key[3];
+  v8f mn = INF;
+  for (int r = 0; r < 3; ++r) {
+    const std::uint32_t b = runs.begin[r];
+    const v8f x = loadu<v8f>(fx + b) - fdx, y = loadu<v8f>(fy + b) - fdy, z = loadu<v8f>(fz + b) - fdz;
+    const v8f k = (x * x + y * y) + z * z;
+    key[r] = lane < static_cast<std::int32_t>(runs.size[r]) ? k : INF;
+    mn = key[r] < mn ? key[r] : mn;
+  }
+  for (const v8i swap : {v8i{4, 5, 6, 7, 0, 1, 2, 3}, v8i{2, 3, 0, 1, 6, 7, 4, 5}, v8i{1, 0, 3, 2, 5, 4, 7, 6}}) {
+    const v8f o = __builtin_shuffle(mn, swap);
+    mn = o < mn ? o : mn;
+  }
+  const float T = candidate_bound(mn[0]);
+  // The candidates of the three runs as one 24-bit mask (run r in bits 8r .. 8r + 7).
+  const v8i bit = v8i{1, 2, 4, 8, 16, 32, 64, 128};
+  v8i m = ((key[0] <= T) & bit) | ((key[1] <= T) & (bit << 8)) | ((key[2] <= T) & (bit << 16));
+  m |= __builtin_shuffle(m, v8i{4, 5, 6, 7, 0, 1, 2, 3});
+  m |= __builtin_shuffle(m, v8i{2, 3, 0, 1, 6, 7, 4, 5});
+  m |= __builtin_shuffle(m, v8i{1, 0, 3, 2, 5, 4, 7, 6});
+  auto bits = static_cast<std::uint32_t>(m[0]);
+  Win w{kInf, kNone};
+  while (bits) {
+    const int t = __builtin_ctz(bits);
+    bits &= bits - 1;
+    const Pt& p = pts[runs.begin[t >> 3] + static_cast<std::uint32_t>(t & 7)];
+    const double x = p.x - dx, y = p.y - dy, z = p.z - dz;
+    const double k = x * x + y * y + z * z;  // contact_key's expression
+    if (key_less(k, p.id, w.key, w.id)) w = Win{k, p.id};
+  }
+  return w;
+}
 #endif  // ASPERITY_GRID_FAST
 
 // ---- the grid -----------------------------------------------------------------------------------
@@ -291,10 +358,30 @@ class Grid final : public ContactQuery {
 
   void lowest(std::span<const Vec3> d, std::span<Nearest> out) const override {
     if (out.size() != d.size()) throw std::invalid_argument("lowest(): output size differs from input size");
+    batch<false>(d, out, [this](const Loc& L, const Vec3& x) { return L.brute ? brute_lowest(c_, x) : search(L, x); });
+  }
+
+  void lowest_winners(std::span<const Vec3> d, std::span<Nearest> out) const override {
+    if (out.size() != d.size()) throw std::invalid_argument("lowest_winners(): output size differs from input size");
+    batch<true>(d, out, [this](const Loc& L, const Vec3& x) { return winner(L, x); });
+  }
+
+  std::size_t memory_bytes() const override {
+    return sizeof(*this) + cs_.capacity() * sizeof(std::uint32_t) + pts_.capacity() * sizeof(Pt) +
+           (edge_.capacity() + invn_.capacity() + guard_.capacity()) * sizeof(double) +
+           guess_.capacity() * sizeof(std::int32_t) + 3 * fx_.capacity() * sizeof(float);
+  }
+
+ private:
+  /// Answers a batch by `answer(loc, d)`; Winners: the winner path's data is prefetched.
+  template <bool Winners, class Answer>
+  void batch(std::span<const Vec3> d, std::span<Nearest> out, Answer answer) const {
     // An index that fits in a core's L2 is answered query by query: the pipeline's prefetches
     // then only cost instructions (N = 10^4: -8% CPU per drop; at N = 3x10^4, 1.6 MB, they pay).
     if (memory_bytes() <= kResidentBytes) {
-      for (std::size_t q = 0; q < d.size(); ++q) out[q] = lowest(d[q]);
+      for (std::size_t q = 0; q < d.size(); ++q) {
+        out[q] = answer(locate(d[q]), d[q]);
+      }
       return;
     }
     // Software pipeline: query q is located (and its cell starts prefetched) at step q, its points
@@ -310,22 +397,16 @@ class Grid final : public ContactQuery {
       }
       if (step >= kLag && step - kLag < n) {
         const Loc& L = loc[(step - kLag) % kRing];
-        if (!L.brute) prefetch_points(L);
+        if (!L.brute) prefetch_points<Winners>(L);
       }
       if (step >= 2 * kLag) {
         const std::size_t q = step - 2 * kLag;
         const Loc& L = loc[q % kRing];
-        out[q] = L.brute ? brute_lowest(c_, d[q]) : search(L, d[q]);
+        out[q] = answer(L, d[q]);
       }
     }
   }
 
-  std::size_t memory_bytes() const override {
-    return sizeof(*this) + cs_.capacity() * sizeof(std::uint32_t) + pts_.capacity() * sizeof(Pt) +
-           (edge_.capacity() + invn_.capacity()) * sizeof(double) + guess_.capacity() * sizeof(std::int32_t);
-  }
-
- private:
   // ---- cell edges -----------------------------------------------------------------------------
 
   void make_edges(double S) {
@@ -428,6 +509,38 @@ class Grid final : public ContactQuery {
       }
     }
     pts_[total] = Pt{0.0, 0.0, 0.0, kNone, 0};
+    // The float rows of the winner path (pads: 0, masked by the run sizes).
+    fx_.assign(total + kPad, 0.0f), fy_.assign(total + kPad, 0.0f), fz_.assign(total + kPad, 0.0f);
+    for (std::size_t k = 0; k < total; ++k) {
+      fx_[k] = static_cast<float>(pts[k].x), fy_[k] = static_cast<float>(pts[k].y), fz_[k] = static_cast<float>(pts[k].z);
+    }
+    make_guards();
+  }
+
+  /// guard_[j G + i]: a key below which the 3x3 window's winner is the winner, for every direction
+  /// located in cell (i, j) of any face (the faces are congruent); 0 for cells at the face border.
+  /// A point outside the window lies beyond one of its four edge planes (edges moved inward by
+  /// kSlack, as in search) or the plane p3 = 0; for d in the cell, y = n.d >= (E_i - E_(i-1) - 2
+  /// kSlack) / (sqrt(1 + E_(i-1)^2) sqrt(1 + s_max^2 + t_max^2)) for the edge s = E_(i-1) (s >= E_i,
+  /// |s| <= s_max, |t| <= t_max, both widened by kSlack), likewise the others, and y >= 1 / sqrt(1 +
+  /// s_max^2 + t_max^2) for p3 = 0. A point beyond a plane at y has key >= 2 y^2 / (1 + sqrt(1 -
+  /// y^2)); the guard is the key for the smallest y shrunk by beyond()'s margins and 1e-6 more.
+  void make_guards() {
+    const int G = G_;
+    const double* E = edge_.data();
+    guard_.assign(static_cast<std::size_t>(G) * static_cast<std::size_t>(G), 0.0);
+    auto mag = [E](int k) { return std::max(std::abs(E[k]), std::abs(E[k + 1])) + kSlack; };
+    for (int j = 1; j + 1 < G; ++j)
+      for (int i = 1; i + 1 < G; ++i) {
+        const double h = std::sqrt(1.0 + mag(i) * mag(i) + mag(j) * mag(j));
+        auto side = [&](int a, int b) {  // edge b of the window, cell edge a on d's side
+          return std::max(std::abs(E[a] - E[b]) - 2.0 * kSlack, 0.0) * invn_[static_cast<std::size_t>(b)] / h;
+        };
+        const double y = std::min({side(i, i - 1), side(i + 1, i + 2), side(j, j - 1), side(j + 1, j + 2), 1.0 / h});
+        const double X = std::min(y * y * (1.0 - kRel), 1.0);
+        const double K = 2.0 * X / (1.0 + std::sqrt(1.0 - X));  // K - K^2/4 = X
+        guard_[static_cast<std::size_t>(j * G + i)] = std::min(K, 1.0) / (1.0 + kRel) * (1.0 - 1e-6);
+      }
   }
 
   // ---- query ----------------------------------------------------------------------------------
@@ -463,11 +576,18 @@ class Grid final : public ContactQuery {
   /// Prefetches the records the fast path reads of the three runs around L: every cache line of
   /// its blocks of four, [b, b + 4 ceil(n / 4)) for a run of n <= kRowSlots points (longer runs
   /// take the general path: their first kRowSlots).
+  /// Winners: the first line of each run's three float rows instead (the records the winner path
+  /// rechecks are usually one, unknown before the float keys).
+  template <bool Winners>
   void prefetch_points(const Loc& L) const noexcept {
     const std::uint32_t* cs = cs_.data() + L.base;
     const int i0 = std::max(L.i - 1, 0), i1 = std::min(L.i + 2, G_);
     for (int r = std::max(L.j - 1, 0); r <= std::min(L.j + 1, G_ - 1); ++r) {
       const std::uint32_t b = cs[r * G_ + i0], n = std::min<std::uint32_t>(cs[r * G_ + i1] - b, kRowSlots);
+      if constexpr (Winners) {
+        prefetch(fx_.data() + b), prefetch(fy_.data() + b), prefetch(fz_.data() + b);
+        continue;
+      }
       const char* lo = reinterpret_cast<const char*>(pts_.data() + b);
       const char* hi = reinterpret_cast<const char*>(pts_.data() + b + ((n + 3) & ~3u));
       for (const char* a = lo; a < hi; a += 64) prefetch(a);
@@ -516,6 +636,36 @@ class Grid final : public ContactQuery {
     }
 #endif
     return grow(L, d, TopTwo{}, false);
+  }
+
+  /// The winner alone (lowest_winners): the 3x3 window's winner by the float kernel, certified by
+  /// the cell's guard (every point outside the window has a key above it, for any direction in the
+  /// cell), else by this direction's own plane bound; otherwise the full search decides.
+  Nearest winner(const Loc& L, const Vec3& d) const {
+    if (L.brute) return winner_only(brute_lowest(c_, d));
+#if ASPERITY_GRID_FAST
+    const int G = G_;
+    const double g = guard_[static_cast<std::size_t>(L.j * G + L.i)];  // 0 at the face border
+    if (g > 0) {
+      const std::uint32_t* cs = cs_.data() + L.base + (L.j - 1) * G + (L.i - 1);
+      Runs runs;
+      for (int r = 0; r < 3; ++r) {
+        runs.begin[r] = cs[r * G];
+        runs.size[r] = cs[r * G + 3] - runs.begin[r];
+      }
+      if (std::max(std::max(runs.size[0], runs.size[1]), runs.size[2]) <= kRowSlots &&
+          runs.size[0] + runs.size[1] + runs.size[2] >= 1) {
+        const Win w = window_winner(fx_.data(), fy_.data(), fz_.data(), pts_.data(), runs, d.x(), d.y(), d.z());
+        if (w.key < g) return Nearest{w.id, w.key, w.id, kInf};
+        const double* E = edge_.data();
+        const double db = L.db, dc = L.dc, d3 = L.d3;
+        const double xs = std::min(plane_x(db - E[L.i - 1] * d3, L.i - 1), plane_x(E[L.i + 2] * d3 - db, L.i + 2));
+        const double xt = std::min(plane_x(dc - E[L.j - 1] * d3, L.j - 1), plane_x(E[L.j + 2] * d3 - dc, L.j + 2));
+        if (beyond(std::min(std::min(xs, xt), d3 * d3), w.key)) return Nearest{w.id, w.key, w.id, kInf};
+      }
+    }
+#endif
+    return winner_only(search(L, d));
   }
 
   void scan(std::uint32_t b, std::uint32_t e, const Vec3& d, TopTwo& top) const noexcept {
@@ -590,6 +740,8 @@ class Grid final : public ContactQuery {
   std::vector<std::int32_t> guess_;  // uniform bin -> cell guess
   Array<std::uint32_t> cs_;          // cell starts, 6 G^2 + 1
   Array<Pt> pts_;                    // stored points and their original indices (+ kPad)
+  Array<float> fx_, fy_, fz_;        // pts_'s coordinates rounded to float (+ kPad): the winner path
+  std::vector<double> guard_;        // per face cell (j G + i): the winner path's certificate
 };
 
 }  // namespace
