@@ -87,6 +87,20 @@ CASES = [
     ("asperity.cor_table(probabilities=-3)", "ValueError", "probabilities"),
     ("asperity.run({'ensemble': {'drops': -1}})", "ValueError", "drops"),
     ("asperity.run({'asperities': {'radius': {'distribution': 'fixed', 'value': float('nan')}}})", "ValueError", "radius"),
+    # issue 33 item 1: recursive and very deep scene dicts are refused before the conversion
+    # recurses (a segfault before), at the scene reader's nesting limit of 16
+    ("asperity.run((lambda d: (d.__setitem__('x', d), d)[1])({'format': 1}))", "ValueError", "contains itself"),
+    ("asperity.scene_toml({'a': (lambda l: (l.append(l), l)[1])([])})", "ValueError", "a[0] contains itself"),
+    ("asperity.scene_toml({'a': __import__('functools').reduce(lambda a, _: [a], range(10**5), 0)})", "ValueError",
+     "nested more than 16 deep"),
+    ("asperity.scene_toml(__import__('functools').reduce(lambda a, _: {'k': a}, range(10**5), 0))", "ValueError",
+     "nested more than 16 deep"),
+    # issue 33 item 8: a lone surrogate names its parameter or key; a bytes __fspath__ is a path
+    ("asperity.preset_text('\\ud800')", "ValueError", "name"),
+    ("asperity.scene_toml('\\ud800')", "ValueError", "scene"),
+    ("asperity.scene_toml({'name': '\\ud800'})", "ValueError", "scene dict: name"),
+    ("asperity.scene_toml({'\\ud800': 1})", "ValueError", "scene dict: a key"),
+    ("asperity.run('fig4', out='\\ud800')", "ValueError", "out"),
 ]
 
 # One child interpreter runs every call in turn and prints one JSON line per call: an abort stops
