@@ -22,6 +22,7 @@
 #include "asperity/app/atomic_file.hpp"
 #include "asperity/app/bounded_read.hpp"
 #include "core/format.hpp"
+#include "text_escape.hpp"
 
 namespace asperity {
 
@@ -471,14 +472,16 @@ void write_ply(const std::filesystem::path& file, const RoughBody& b, PlyStyle s
   // sets badbit and drops the rest).
   std::string os;
   const std::uint64_t bound =
-      b.name.size() + ply_text_bytes(b.size(), style, style == PlyStyle::points ? 0 : nbv, style == PlyStyle::points ? 0 : nbf);
+      4 * b.name.size() + ply_text_bytes(b.size(), style, style == PlyStyle::points ? 0 : nbv, style == PlyStyle::points ? 0 : nbf);
   try {
     os.reserve(bound);
   } catch (const std::bad_alloc&) {  // named: the export is what did not fit
     throw std::runtime_error("cannot write " + file.string() + ": out of memory for its text (up to " +
                              std::to_string(bound / 1000000) + " MB; outputs.export_style = \"points\" is ~15x smaller)");
   }
-  os += "ply\nformat ascii 1.0\ncomment asperity rough body '" + b.name + "', body frame, metres\n";
+  // The body's name (the mesh file's) escaped: a newline in it would end the comment and write
+  // header lines of its own ("element vertex 0\nend_header"); a PLY header is ASCII.
+  os += "ply\nformat ascii 1.0\ncomment asperity rough body '" + detail::escaped(b.name, true, true) + "', body frame, metres\n";
   if (style == PlyStyle::points) {
     os += "element vertex " + std::to_string(b.size()) +
           "\nproperty double x\nproperty double y\nproperty double z\nproperty double radius\nend_header\n";
