@@ -96,7 +96,10 @@ std::string format_bounce_table(const std::vector<BounceVariantReport>& reports)
                       fmt("%.2e", g.residual_std).c_str(), rate(g.residual_fit.a.value, g.theory_rate_below).c_str(),
                       rate(g.residual_fit.c.value, g.theory_rate_above).c_str(), "",
                       g.has_theory ? fmt("%.4f", g.theory_ks.D).c_str() : "-", g.has_theory ? fmt("%.2g", g.theory_ks.p).c_str() : "-",
-                      (fmt("%+.4f", g.speed_residual_correlation.value) + " +- " + fmt("%.4f", g.speed_residual_correlation.se)).c_str());
+                      // undefined where u does not vary (k = 1: every sequence starts at the same speed): "-", as null in the JSON
+                      (std::isfinite(g.speed_residual_correlation.value)
+                           ? fmt("%+.4f", g.speed_residual_correlation.value) + " +- " + fmt("%.4f", g.speed_residual_correlation.se)
+                           : std::string("- (u constant)")).c_str());
         o << line;
       }
     o << "res = eps - eps_n(u_k); a, c fit: Eq. 2 fitted to res (no bootstrap); (theory): rates of the semi-analytic law at "
