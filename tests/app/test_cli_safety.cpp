@@ -230,11 +230,11 @@ TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
       {"--preset fig6 --variant paper,paper", "", "--variant: 'paper' is given twice"},
       // issue 33 item 6: NaN reported with exit 0 (1e155, gravity 1e19, 5e-324) or an internal
       // message (1e7): a bounce's stated ranges, key and value named
-      {"--preset fig6 --asperities 1000 --sequences 20 --speed 1e155", "", "speed = 1e+155 m/s is outside the supported range (0, 1000]"},
-      {"--preset fig6 --asperities 1000 --sequences 20 --speed 1e7", "", "speed = 1e+07 m/s is outside the supported range"},
-      {"", "format = 1\n[experiment]\nkind = \"bounce\"\ngravity = 1e19\n", "gravity = 1e+19 m/s^2 is outside the supported range"},
+      {"--preset fig6 --asperities 1000 --sequences 20 --speed 1e155", "", "experiment.speed (--speed): 1e+155 m/s is outside the supported range (0, 1000]"},
+      {"--preset fig6 --asperities 1000 --sequences 20 --speed 1e7", "", "experiment.speed (--speed): 1e+07 m/s is outside the supported range"},
+      {"", "format = 1\n[experiment]\nkind = \"bounce\"\ngravity = 1e19\n", ":4: experiment.gravity: 1e+19 m/s^2 is outside the supported range"},
       {"", "format = 1\n[experiment]\nkind = \"bounce\"\ngravity = 5e-324\n", "gravity"},
-      {"", "format = 1\n[experiment]\nkind = \"bounce\"\nspeed = 1e155\n", "speed"},
+      {"", "format = 1\n[experiment]\nkind = \"bounce\"\nspeed = 1e155\n", ":4: experiment.speed"},
       {"--omega-y 1e6", mesh_bounce_scene(), "must be <= 1000 m/s"},
       {"", "format = 1\n[experiment]\nkind = \"bounce\"\nvariants = \"dynamic,paper,dynamic\"\n", "experiment.variants"},
       // 10: integers as integers
