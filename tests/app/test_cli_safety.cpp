@@ -426,6 +426,27 @@ TEST(CliOutput, EscapeSequencesInNamesAndKeysAreShownEscaped) {
   fs::remove_all(dir);
 }
 
+// Issue 33 item 6: --preset fig4 --omega-x 1e-5 skipped every Eq. 28 law, the decisive one too,
+// because Eq. 28 as printed (an info law) is NaN at that spin and the laws of a quantity were
+// tested together. Each law is now evaluated alone: the printed one is skipped, eq28-corrected
+// decides (and the run would have said so in its verdict and exit status).
+TEST(CliRefusals, OneLawThatCannotBeEvaluatedSkipsOnlyItself) {
+  const fs::path out = fresh_dir("tiny-spin");
+  const auto r = run_command(vg() + " -q --preset fig4 --asperities 1000 --drops 20000 --omega-x 1e-5 --no-plots --out " +
+                             out.string() + " 2>&1");
+  EXPECT_TRUE(r.status == 0 || r.status == 1) << r.out;
+  const std::string report = slurp(out / "report.json");
+  const auto row = [&](const std::string& law) {  // the verdict of the eps row of `law`
+    const auto at = report.find("\"law\": \"" + law + "\",\n      \"n\"");  // keys are sorted: verdict follows
+    const auto v = report.find("\"verdict\": \"", at);
+    return at == std::string::npos ? std::string("absent") : report.substr(v + 12, report.find('"', v + 12) - v - 12);
+  };
+  EXPECT_NE(row("eq28-corrected"), "skipped") << report.substr(0, 200);
+  EXPECT_NE(row("eq28-corrected"), "absent");
+  EXPECT_EQ(r.out.find("eq28-corrected (skipped)"), std::string::npos) << r.out;
+  fs::remove_all(out);
+}
+
 // Issue 33 item 8: kill -9 leaves a staging directory no handler could remove; the next run in the
 // directory removes those of dead processes only -- never a live process's, a link, or a file.
 TEST(CliOutput, StagingDirectoriesOfDeadRunsAreRemovedByTheNextRun) {
