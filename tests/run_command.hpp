@@ -52,7 +52,7 @@ inline pid_t spawn_cli(const std::string& program, const std::vector<std::string
   std::fflush(nullptr);  // the child must not repeat our buffered output
   const pid_t pid = ::fork();
   if (pid == 0) {
-    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) ::signal(s, SIG_DFL);
+    for (int s : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT, SIGALRM, SIGXCPU, SIGXFSZ}) ::signal(s, SIG_DFL);
     sigset_t none;
     sigemptyset(&none);
     ::sigprocmask(SIG_SETMASK, &none, nullptr);

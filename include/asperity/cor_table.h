@@ -589,16 +589,25 @@ static inline double asperity_cor__interp(const asperity_cor_table *t, const dou
   return r;
 }
 
+/* Whether `t` holds a table: a failed or absent load leaves it empty (every field 0 or NULL), and
+ * sampling an empty table dereferenced NULL (issue 33 item 8); the samplers return NAN instead. */
+static inline int asperity_cor__loaded(const asperity_cor_table *t) {
+  return t && t->n_speeds >= 1 && t->n_probs >= 2 && t->n_spins >= 1 && t->speeds && t->probs && t->spins && t->eps;
+}
+
 /** eps for an impact at `speed` [m/s] with incoming spin `spin` [rad/s] and the host's uniform u in
- * [0, 1]: trilinear in (spin, speed, p). Format 1 tables have one spin (the argument is ignored). */
+ * [0, 1]: trilinear in (spin, speed, p). Format 1 tables have one spin (the argument is ignored).
+ * NAN for a table that is not loaded (NULL, or one whose asperity_cor_load failed). */
 static inline double asperity_cor_sample_spin(const asperity_cor_table *t, double spin, double speed, double u) {
+  if (!asperity_cor__loaded(t)) return (double)NAN;
   return asperity_cor__interp(t, t->eps, (size_t)t->n_probs, spin, speed, asperity_cor__clamp01(u));
 }
 
 /** eps for an impact at `speed` [m/s] and the host's uniform u in [0, 1]: bilinear interpolation of
  * the quantile table in (speed, p), at the table's first spin. */
 static inline double asperity_cor_sample(const asperity_cor_table *t, double speed, double u) {
-  return asperity_cor_sample_spin(t, t->n_spins > 0 ? t->spins[0] : 0.0, speed, u);
+  if (!asperity_cor__loaded(t)) return (double)NAN;
+  return asperity_cor_sample_spin(t, t->spins[0], speed, u);
 }
 
 /** Omega'_x [rad/s] after the impact whose eps was drawn with u: quantile u2 of Omega'_x among the
@@ -607,7 +616,7 @@ static inline double asperity_cor_sample(const asperity_cor_table *t, double spe
 static inline double asperity_cor_sample_omega(const asperity_cor_table *t, double spin, double speed, double u,
                                                double u2) {
   int b;
-  if (t->n_bands < 1 || !t->omega) return (double)NAN;
+  if (!asperity_cor__loaded(t) || t->n_bands < 1 || !t->omega) return (double)NAN;
   u = asperity_cor__clamp01(u);
   b = (int)(u * t->n_bands);
   if (b >= t->n_bands) b = t->n_bands - 1;

@@ -215,6 +215,7 @@ std::string read_state_file(const fs::path& path, std::size_t size, const Scene&
 std::string checkpoint_key(const Scene& s) {
   Scene k = s;
   k.ensemble.threads = 0;
+  k.ensemble.kernel = Kernel::simd;  // the kernel changes no bit: --resume DIR --kernel scalar continues it
   k.plots = true;
   k.plot_format = "png";  // figures change no result
   k.out = "DIR";  // the directory may be named differently (relative, absolute) when resumed

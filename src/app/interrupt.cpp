@@ -37,7 +37,11 @@ std::atomic<bool> g_installed{false};
 std::atomic<bool> g_committed{false};  // the run's files are in place: nothing of it to remove
 const char* g_program = "asperity";
 
-constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE};
+// Every signal whose default action ends the process and that a user, a shell or a resource limit
+// sends to a running program: each ends the run the same way (issue 33: SIGQUIT, SIGALRM, SIGXCPU
+// and SIGXFSZ left the staging directory behind). SIGKILL cannot be caught: the next run in the
+// directory removes what it left (remove_stale_staging).
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT, SIGALRM, SIGXCPU, SIGXFSZ};
 
 void put(const char* s) {
   std::size_t n = 0;
@@ -56,6 +60,10 @@ const char* signal_name(int sig) {
     case SIGTERM: return "SIGTERM";
     case SIGHUP: return "SIGHUP";
     case SIGPIPE: return "SIGPIPE";
+    case SIGQUIT: return "SIGQUIT";
+    case SIGALRM: return "SIGALRM";
+    case SIGXCPU: return "SIGXCPU";
+    case SIGXFSZ: return "SIGXFSZ";
   }
   return "a signal";
 }

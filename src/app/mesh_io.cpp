@@ -12,15 +12,17 @@
 #include <cctype>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <new>
+#include <optional>
 #include <sstream>
-#include <new>
 #include <stdexcept>
 #include <vector>
 
 #include "asperity/app/atomic_file.hpp"
 #include "asperity/app/bounded_read.hpp"
 #include "core/format.hpp"
+#include "text_escape.hpp"
 
 namespace asperity {
 
@@ -68,6 +70,241 @@ void check_header_counts(const std::filesystem::path& file, std::uint64_t size) 
                                 " vertices and faces, more than its " + std::to_string(size) + " bytes can hold");
 }
 
+// ---- list counts: every count in the body of an OFF or PLY file bounded before CGAL reads it ----
+//
+// CGAL resizes a face's index vector to the count the file states before reading one index
+// (OFF.h: resize(polygons[i], no); PLY_reader.h: m_buffer.resize(size)), so one face line
+// "4000000000 0 2 1" in a 227-byte file made it allocate 12 GB. Each list is walked here first and
+// its count bounded by what the rest of the file can hold: an ASCII item takes at least 2 bytes
+// ("0 "), a binary one its type's size. So the items of all lists together never exceed the file's
+// size (at most 1 GiB), whatever the counts claim. A face's vertex list is bounded besides by the
+// vertices the header states (a polygon has no more corners than the mesh has vertices), which
+// the memory estimate already covers (resources.cpp: vertices and faces from the header).
+
+/// Reads a file in blocks; tracks the offset so that "the rest of the file" is known.
+class MeshScan {
+ public:
+  MeshScan(const std::filesystem::path& file, std::uint64_t size) : in_(file, std::ios::binary), size_(size) {}
+  std::uint64_t left() const { return size_ > pos_ ? size_ - pos_ : 0; }
+  bool get(char& c) {
+    if (at_ == end_ && !fill()) return false;
+    c = buf_[at_++];
+    ++pos_;
+    return true;
+  }
+  bool line(std::string& l) {  // one line without its '\n'; false at the end of the file
+    l.clear();
+    char c = 0;
+    bool any = false;
+    while (get(c)) {
+      any = true;
+      if (c == '\n') return true;
+      if (l.size() < kMaxLine) l += c;
+    }
+    return any;
+  }
+  bool token(std::string& t) {  // the next whitespace-separated word
+    t.clear();
+    char c = 0;
+    bool got = false;
+    while ((got = get(c)) && std::isspace(static_cast<unsigned char>(c))) {
+    }
+    if (!got) return false;
+    do {
+      if (t.size() < kMaxLine) t += c;
+    } while (get(c) && !std::isspace(static_cast<unsigned char>(c)));
+    return true;
+  }
+  bool bytes(unsigned char* out, std::size_t n) {
+    char c = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!get(c)) return false;
+      if (out) out[i] = static_cast<unsigned char>(c);
+    }
+    return true;
+  }
+  bool skip(std::uint64_t n) {
+    if (n > left()) return false;
+    const std::uint64_t in_buf = end_ - at_;
+    if (n <= in_buf) return at_ += n, pos_ += n, true;
+    pos_ += n, at_ = end_ = 0;
+    in_.seekg(static_cast<std::streamoff>(pos_));
+    return static_cast<bool>(in_);
+  }
+
+ private:
+  static constexpr std::size_t kMaxLine = 256;  // a count is short; the rest of a long line is not kept
+  bool fill() {
+    in_.read(buf_, sizeof buf_);
+    end_ = static_cast<std::size_t>(in_.gcount());
+    at_ = 0;
+    return end_ > 0;
+  }
+  std::ifstream in_;
+  std::uint64_t size_, pos_ = 0;
+  char buf_[1 << 16];
+  std::size_t at_ = 0, end_ = 0;
+};
+
+[[noreturn]] void refuse_count(const std::filesystem::path& file, const std::string& where, const std::string& count,
+                               const std::string& why) {
+  throw std::invalid_argument("mesh file '" + file.string() + "': " + where + " claims " + count + " entries, " + why);
+}
+
+/// An unsigned decimal integer, or nullopt (a malformed count is left to CGAL, which refuses it).
+std::optional<std::uint64_t> count_of(const std::string& t) {
+  std::uint64_t v = 0;
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (r.ec == std::errc::result_out_of_range) return std::numeric_limits<std::uint64_t>::max();
+  if (r.ec != std::errc() || r.ptr != t.data() + t.size()) return std::nullopt;
+  return v;
+}
+
+/// A list count checked against the rest of the file (`item` bytes at least per entry) and, for a
+/// face's vertex list, the mesh's vertex count.
+void check_count(const std::filesystem::path& file, const std::string& where, std::uint64_t k, std::uint64_t item,
+                 std::uint64_t left, std::uint64_t corners_max) {
+  if (k > left / item + 1)
+    refuse_count(file, where, std::to_string(k), "more than the " + std::to_string(left) + " bytes after it can hold");
+  if (k > corners_max)
+    refuse_count(file, where, std::to_string(k), "more corners than the mesh's " + std::to_string(corners_max) + " vertices");
+}
+
+void check_off_lists(const std::filesystem::path& file, std::uint64_t size) {
+  MeshScan in(file, size);
+  std::string l;
+  auto content = [&](std::string& out) {  // the next line that is neither blank nor a comment
+    while (in.line(out)) {
+      const auto b = out.find_first_not_of(" \t\r");
+      if (b != std::string::npos && out[b] != '#') return true;
+    }
+    return false;
+  };
+  if (!content(l)) return;
+  if (l.find("BINARY") != std::string::npos)
+    throw std::invalid_argument("mesh file '" + file.string() + "': binary OFF is not read (its list counts cannot be " +
+                                "bounded before CGAL allocates for them); write it as ASCII OFF or PLY");
+  std::istringstream head(l);
+  std::string tok;
+  std::vector<std::uint64_t> n;
+  while (head >> tok) {  // "OFF" and the counts may share the first line
+    if (tok.ends_with("OFF")) continue;
+    if (auto v = count_of(tok)) n.push_back(*v);
+  }
+  if (n.size() < 2 && content(l)) {
+    std::istringstream counts(l);
+    while (n.size() < 2 && counts >> tok)
+      if (auto v = count_of(tok)) n.push_back(*v);
+  }
+  if (n.size() < 2) return;  // CGAL refuses it
+  for (std::uint64_t i = 0; i < n[0]; ++i)
+    if (!content(l)) return;
+  for (std::uint64_t i = 0; i < n[1]; ++i) {
+    const std::uint64_t left = in.left();  // bytes from this face's line on
+    if (!content(l)) return;
+    std::istringstream face(l);
+    if (!(face >> tok)) return;
+    const auto k = count_of(tok);
+    if (!k) return;
+    check_count(file, "face " + std::to_string(i), *k, 2, left, n[0]);
+  }
+}
+
+/// The size of a PLY scalar type, 0 if it is not one.
+std::uint64_t ply_type_size(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+struct PlyProperty {
+  std::uint64_t size = 0;       // a scalar's size; a list's item size
+  std::uint64_t count_size = 0; // a list's count type size; 0 for a scalar
+  std::string name;
+};
+struct PlyElement {
+  std::string name;
+  std::uint64_t rows = 0;
+  std::vector<PlyProperty> props;
+};
+
+std::uint64_t binary_count(const unsigned char* b, std::uint64_t n, bool big_endian) {
+  std::uint64_t v = 0;
+  for (std::uint64_t i = 0; i < n; ++i) v |= std::uint64_t{b[big_endian ? n - 1 - i : i]} << (8 * i);
+  return v;  // signed count types: a negative count reads as a huge one and is refused
+}
+
+void check_ply_lists(const std::filesystem::path& file, std::uint64_t size) {
+  MeshScan in(file, size);
+  std::string l;
+  int format = -1;  // 0 ascii, 1 little endian, 2 big endian
+  std::vector<PlyElement> elements;
+  std::uint64_t vertices = 0;
+  for (bool first = true; in.line(l); first = false) {
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    if (first && l != "ply") return;
+    std::istringstream w(l);
+    std::string kw, a, b, c;
+    w >> kw;
+    if (kw == "end_header") break;
+    if (kw == "format" && w >> a) format = a == "ascii" ? 0 : a == "binary_little_endian" ? 1 : a == "binary_big_endian" ? 2 : -1;
+    if (kw == "element" && w >> a >> b) {
+      const auto rows = count_of(b);
+      if (!rows) return;
+      elements.push_back({a, *rows, {}});
+      if (a == "vertex") vertices = *rows;
+    }
+    if (kw == "property" && !elements.empty() && w >> a) {
+      PlyProperty p;
+      if (a == "list" && w >> b >> c) {
+        p.count_size = ply_type_size(b), p.size = ply_type_size(c);
+        if (p.count_size == 0 || p.size == 0) return;
+      } else {
+        p.size = ply_type_size(a);
+        if (p.size == 0) return;
+      }
+      w >> p.name;
+      elements.back().props.push_back(p);
+    }
+  }
+  if (format < 0) return;
+  std::string tok;
+  unsigned char buf[8];
+  for (const auto& e : elements)
+    for (std::uint64_t r = 0; r < e.rows; ++r)
+      for (const auto& p : e.props) {
+        const std::string where = e.name + " " + std::to_string(r) + " '" + p.name + "'";
+        const std::uint64_t corners = e.name == "face" ? vertices : std::numeric_limits<std::uint64_t>::max();
+        if (format == 0) {
+          if (!in.token(tok)) return;
+          if (p.count_size == 0) continue;
+          const auto k = count_of(tok);
+          if (!k) return;
+          check_count(file, where, *k, 2, in.left(), corners);
+          for (std::uint64_t i = 0; i < *k; ++i)
+            if (!in.token(tok)) return;
+        } else if (p.count_size == 0) {
+          if (!in.skip(p.size)) return;
+        } else {
+          if (!in.bytes(buf, p.count_size)) return;
+          const std::uint64_t k = binary_count(buf, p.count_size, format == 2);
+          check_count(file, where, k, p.size, in.left(), corners);
+          if (!in.skip(k * p.size)) return;
+        }
+      }
+}
+
+/// Every list count of an OFF or PLY file bounded (the other formats state no counts CGAL trusts:
+/// OBJ faces are their tokens, STL faces are triangles).
+void check_list_counts(const std::filesystem::path& file, std::uint64_t size) {
+  std::string ext = file.extension().string();
+  for (auto& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext == ".off") check_off_lists(file, size);
+  if (ext == ".ply") check_ply_lists(file, size);
+}
+
 }  // namespace
 
 TriangleMesh read_mesh(const std::filesystem::path& file, double scale) {
@@ -82,6 +319,7 @@ TriangleMesh read_mesh(const std::filesystem::path& file, double scale) {
     throw std::invalid_argument(e.what());
   }
   check_header_counts(file, size);
+  check_list_counts(file, size);
   Mesh sm;
   bool read = false;
   try {
@@ -234,14 +472,16 @@ void write_ply(const std::filesystem::path& file, const RoughBody& b, PlyStyle s
   // sets badbit and drops the rest).
   std::string os;
   const std::uint64_t bound =
-      b.name.size() + ply_text_bytes(b.size(), style, style == PlyStyle::points ? 0 : nbv, style == PlyStyle::points ? 0 : nbf);
+      4 * b.name.size() + ply_text_bytes(b.size(), style, style == PlyStyle::points ? 0 : nbv, style == PlyStyle::points ? 0 : nbf);
   try {
     os.reserve(bound);
   } catch (const std::bad_alloc&) {  // named: the export is what did not fit
     throw std::runtime_error("cannot write " + file.string() + ": out of memory for its text (up to " +
                              std::to_string(bound / 1000000) + " MB; outputs.export_style = \"points\" is ~15x smaller)");
   }
-  os += "ply\nformat ascii 1.0\ncomment asperity rough body '" + b.name + "', body frame, metres\n";
+  // The body's name (the mesh file's) escaped: a newline in it would end the comment and write
+  // header lines of its own ("element vertex 0\nend_header"); a PLY header is ASCII.
+  os += "ply\nformat ascii 1.0\ncomment asperity rough body '" + detail::escaped(b.name, true, true) + "', body frame, metres\n";
   if (style == PlyStyle::points) {
     os += "element vertex " + std::to_string(b.size()) +
           "\nproperty double x\nproperty double y\nproperty double z\nproperty double radius\nend_header\n";

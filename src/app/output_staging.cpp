@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #include "asperity/app/output_staging.hpp"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -31,7 +34,47 @@ std::string random_suffix() {
   return s.str();
 }
 
+// The pid a staging directory's name starts with (".asperity-staging-<pid>-<hex>"), 0 if none.
+pid_t staging_pid(std::string_view name) {
+  if (name.substr(0, kStagingPrefix.size()) != kStagingPrefix) return 0;
+  name.remove_prefix(kStagingPrefix.size());
+  long long pid = 0;
+  std::size_t i = 0;
+  for (; i < name.size() && name[i] >= '0' && name[i] <= '9' && pid < (1LL << 31); ++i) pid = pid * 10 + (name[i] - '0');
+  if (i == 0 || i >= name.size() || name[i] != '-' || pid <= 0 || pid >= (1LL << 31)) return 0;
+  return static_cast<pid_t>(pid);
+}
+
+// Whether a process `pid` exists (EPERM: it exists, another user's).
+bool process_alive(pid_t pid) { return ::kill(pid, 0) == 0 || errno == EPERM; }
+
+// A live run's staging directory in `out`, named for the "in use" message ("" if none is seen).
+std::string live_staging(const fs::path& out) {
+  std::error_code ec;
+  for (fs::directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (const pid_t pid = staging_pid(name); pid != 0 && process_alive(pid)) return name;
+  }
+  return "";
+}
+
 }  // namespace
+
+std::size_t remove_stale_staging(const fs::path& out) {
+  std::size_t removed = 0;
+  std::error_code ec;
+  for (fs::directory_iterator it(out, ec), end; !ec && it != end; it.increment(ec)) {
+    const fs::path p = it->path();
+    const pid_t pid = staging_pid(p.filename().string());
+    if (pid == 0 || pid == ::getpid() || process_alive(pid)) continue;  // ours, a live run's, or not a staging name
+    struct stat st {};
+    if (::lstat(p.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::geteuid()) continue;
+    std::error_code rm;
+    fs::remove_all(p, rm);  // does not follow links inside it
+    if (!rm) ++removed;
+  }
+  return removed;
+}
 
 std::string output_name_problem(std::string_view name) {
   if (name.empty()) return "is empty";
@@ -59,6 +102,7 @@ OutputStaging::OutputStaging(const fs::path& out) : out_(out) {
     create(out);
   } catch (...) {
     remove_created_directories();
+    if (lock_fd_ >= 0) ::close(lock_fd_);
     throw;
   }
 }
@@ -101,6 +145,8 @@ void OutputStaging::create(const fs::path& out) {
     throw std::runtime_error("cannot create directory '" + out.string() + "': " + reason(err));
   }
   if (!S_ISDIR(st.st_mode)) throw std::runtime_error("'" + out.string() + "' is not a directory");
+  lock(out);
+  remove_stale_staging(out);
   dir_ = out / (std::string(kStagingPrefix) + random_suffix());
   guards_.push_back(std::make_unique<InterruptCleanup>(dir_));
   const int rc = ::mkdir(dir_.c_str(), 0700);
@@ -111,10 +157,34 @@ void OutputStaging::create(const fs::path& out) {
   }
 }
 
+// One run at a time in a directory: a run finishing in it removes its checkpoint files, which
+// would be another run's (issue 33 item 3). flock on the directory itself: nothing is created in
+// it, and the lock goes with the process however it ends (kill -9 included). A file system that
+// cannot lock (ENOLCK, EINVAL, EBADF: some network file systems) runs unlocked, as before.
+void OutputStaging::lock(const fs::path& out) {
+  lock_fd_ = ::open(out.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock_fd_ < 0) {
+    const int err = errno;
+    throw std::runtime_error("cannot open directory '" + out.string() + "': " + reason(err));
+  }
+  while (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    if (err == EINTR) continue;
+    if (err != EWOULDBLOCK) return;
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    const std::string who = live_staging(out);
+    throw std::runtime_error("'" + out.string() + "' is in use by another run" +
+                             (who.empty() ? std::string() : " (its staging directory " + who + ")") +
+                             "; wait for it to end or choose another --out");
+  }
+}
+
 OutputStaging::~OutputStaging() {
   std::error_code ec;
   fs::remove_all(dir_, ec);
   if (!committed_) remove_created_directories();
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the lock, after the staging directory is gone
 }
 
 void OutputStaging::add(const std::string& name) {
@@ -128,15 +198,20 @@ void OutputStaging::add(const std::string& name) {
   names_.push_back(name);
 }
 
-std::vector<fs::path> OutputStaging::commit() {
-  // Nothing moves unless every target can be replaced: a regular file or nothing.
-  for (const auto& n : names_) {
+void OutputStaging::check_replaceable(const std::vector<std::string>& names) const {
+  for (const auto& n : names) {
     const fs::path target = out_ / n;
     struct stat st {};
     if (::lstat(target.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
       throw std::runtime_error("cannot write " + target.string() + ": " + reason(S_ISDIR(st.st_mode) ? EISDIR : EEXIST) +
-                               " (it is not a regular file; nothing was changed in " + out_.string() + ")");
+                               " (it is " + (S_ISLNK(st.st_mode) ? "a symbolic link" : S_ISDIR(st.st_mode) ? "a directory" : "not a regular file") +
+                               ", never replaced; nothing was changed in " + out_.string() + ")");
   }
+}
+
+std::vector<fs::path> OutputStaging::commit() {
+  // Nothing moves unless every target can be replaced: a regular file or nothing.
+  check_replaceable(names_);
   struct Moved {
     fs::path target, backup;  // backup empty: the target did not exist before
   };

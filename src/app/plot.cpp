@@ -180,15 +180,13 @@ PlotFormats parse_plot_formats(std::string_view text) {
   PlotFormats f{false, false, false};
   std::string_view rest = text;
   if (const auto at = text.find('@'); at != std::string_view::npos) {
-    const std::string s(text.substr(at + 1));
-    std::size_t used = 0;
+    // A plain decimal number (std::from_chars, fixed or scientific): std::stod also took hex
+    // ("png@0x2") and leading spaces ("png@ 2"), which no other number of asperity accepts.
+    const std::string_view s = text.substr(at + 1);
     double v = 0;
-    try {
-      v = std::stod(s, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != s.size() || !(v >= 0.25 && v <= 8))
+    const auto r = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
+    const bool plain = !s.empty() && ((s[0] >= '0' && s[0] <= '9') || s[0] == '.');
+    if (!plain || r.ec != std::errc() || r.ptr != s.data() + s.size() || !(v >= 0.25 && v <= 8))
       throw std::invalid_argument("plot format \"" + std::string(text) + "\": the size factor after '@' must be a number in [0.25, 8]");
     f.scale = v;
     rest = text.substr(0, at);

@@ -435,10 +435,11 @@ void check_scene_inputs(const Scene& s) {
   const Vec3 omega = s.bounce.enabled ? s.bounce.omega : s.ensemble.impact.omega;
   const std::string key = "experiment.Omega (--omega-x/--omega-y)";
   const double surface = omega.stableNorm() * L;
-  if (!(surface <= kMaxSpeed))
+  const double max_surface = s.bounce.enabled ? kMaxBounceSpeed : kMaxSpeed;  // a bounce: Eq. 9's range (bounce.hpp)
+  if (!(surface <= max_surface))
     throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
                                 " m (the body's bounding radius) gives a surface speed of " + show(surface) +
-                                " m/s; must be <= " + show(kMaxSpeed) + " m/s (supported range)");
+                                " m/s; must be <= " + show(max_surface) + " m/s (supported range)");
   if (!s.bounce.enabled && !(surface < s.ensemble.impact.speed))
     throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
                                 " m (the body's bounding radius; body.scale = " + show(m.scale) +

@@ -11,6 +11,7 @@
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "core/format.hpp"
+#include "text_escape.hpp"
 #include "asperity_embedded_scenes.hpp"  // generated from scenes/*.toml (CMakeLists.txt)
 
 namespace asperity {
@@ -114,6 +115,23 @@ void validate_outputs(const Scene& s) {
   if (s.cor_table) validate_cor_table(s);
 }
 
+// Every name that report.json (JSON) and checkpoint.toml (TOML) hold as text: both hold UTF-8
+// only, so a name with another byte (a POSIX path may hold any) is refused here, before the run;
+// it was a JSON library's message after the whole run (issue 33 item 7), and a checkpoint that
+// could not be resumed. UTF-8 names round-trip (to_toml writes them as \u escapes).
+void validate_text_names(const Scene& s) {
+  const auto check = [](const std::string& key, const std::string& v) {
+    if (const std::string why = detail::utf8_problem(v); !why.empty())
+      throw std::invalid_argument(key + ": \"" + detail::escaped(v) + "\": " + why +
+                                  " (report.json and checkpoint.toml hold it as UTF-8 text); choose a UTF-8 name");
+  };
+  check("outputs.dir (--out)", s.out.string());
+  check("outputs.report", s.report);
+  check("name", s.name);
+  if (s.mesh) check("body.mesh", s.mesh->file.string()), check("outputs.export_ply", s.mesh->export_ply);
+  if (s.cor_table) check("outputs.cor_table.file", s.cor_table->file);
+}
+
 void validate_bounce(const Scene& s) {
   if (s.bounce.enabled) {
     validate(s.bounce);
@@ -200,6 +218,7 @@ void validate(const Scene& s) {
   if (!(s.alpha > 0 && s.alpha < 1))
     throw std::invalid_argument("alpha must be in (0, 1), got " + std::to_string(s.alpha));
   if (s.out.empty()) throw std::invalid_argument("out must not be empty");
+  validate_text_names(s);
   validate_outputs(s);
   if (s.name.empty()) throw std::invalid_argument("name must not be empty");
   validate_bounce(s);

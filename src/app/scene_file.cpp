@@ -5,6 +5,7 @@
 #include "asperity/app/bounded_read.hpp"
 #include "asperity/app/output_staging.hpp"
 #include "asperity/app/plot.hpp"
+#include "text_escape.hpp"
 
 #define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
 #include <toml++/toml.h>
@@ -34,7 +35,12 @@ std::string num(double v) {
 
 std::string quote(std::string_view s) {
   std::string out = "\"";
-  for (const char c : s) {
+  std::size_t skip = 0;  // continuation bytes of a UTF-8 sequence already written
+  for (const char& c : s) {
+    if (skip > 0) {
+      --skip;
+      continue;
+    }
     const auto u = static_cast<unsigned char>(c);
     if (c == '"' || c == '\\') {
       out += '\\';
@@ -43,6 +49,19 @@ std::string quote(std::string_view s) {
       char buf[8];
       std::snprintf(buf, sizeof buf, "\\u%04x", u);
       out += buf;
+    } else if (u >= 0x80) {
+      // Scene files are ASCII (bad_brackets): a non-ASCII name is written as \u or \U escapes,
+      // which toml++ reads back as the same UTF-8 bytes (a checkpoint of --out résumé resumes).
+      // A byte that is not UTF-8 cannot be held by TOML at all: such a path is refused before
+      // any run (validate, detail::utf8_problem); here (a message) it shows as U+FFFD.
+      std::uint32_t cp = 0;
+      const std::size_t n = detail::utf8_at(s, static_cast<std::size_t>(&c - s.data()), cp);
+      const unsigned v = n == 0 ? 0xfffdu : static_cast<unsigned>(cp);
+      char buf[16];
+      if (v > 0xffff) std::snprintf(buf, sizeof buf, "\\U%08x", v);
+      else std::snprintf(buf, sizeof buf, "\\u%04x", v);
+      out += buf;
+      skip = n == 0 ? 0 : n - 1;
     } else {
       out += c;
     }
@@ -957,6 +976,14 @@ std::filesystem::path resolve_mesh(const std::filesystem::path& mesh, const std:
   }
   for (const auto& p : tried)
     if (fs::is_regular_file(p, ec)) return p.lexically_normal();
+  // The first path that exists but is no file is named as what it is (it was "not found").
+  for (const auto& p : tried)
+    if (const auto st = fs::status(p, ec); fs::exists(st)) {
+      const char* what = fs::is_directory(st) ? "a directory" : fs::is_fifo(st) ? "a FIFO" : fs::is_socket(st) ? "a socket"
+                         : fs::is_block_file(st) || fs::is_character_file(st) ? "a device" : "not a regular file";
+      throw SceneError(scene_file.string() + ": body.mesh: " + quote(p.string()) + " is " + what + ", not a mesh file",
+                       "body.mesh");
+    }
   std::string where;
   for (const auto& p : tried) where += (where.empty() ? "" : ", ") + p.string();
   throw SceneError(scene_file.string() + ": body.mesh: mesh file " + quote(mesh.string()) + " not found (looked for " +

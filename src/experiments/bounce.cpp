@@ -55,20 +55,28 @@ BounceVariant parse_bounce_variant(std::string_view s) {
 }
 
 void validate(const BounceExperiment& b) {
+  // Messages start with the scene key: the scene reader points at that key's line (a message
+  // without one was reported at line 1, issue 33 item 8).
   auto pos = [](const char* f, double v) {
-    if (!std::isfinite(v) || !(v > 0)) throw std::invalid_argument(std::string("bounce: ") + f + " must be finite and > 0, got " + num(v));
+    if (!std::isfinite(v) || !(v > 0)) throw std::invalid_argument(std::string(f) + ": must be finite and > 0, got " + num(v));
   };
   if (b.variants.empty()) throw std::invalid_argument("bounce: no variant selected");
   if (b.sequences < 1 || b.sequences > 0xFFFFFFFFull)
-    throw std::invalid_argument("bounce: sequences must be in [1, 2^32 - 1], got " + std::to_string(b.sequences));
-  pos("speed", b.speed);
-  if (!b.omega.allFinite()) throw std::invalid_argument("bounce: Omega must be finite");
-  pos("stop_speed", b.stop_speed);
+    throw std::invalid_argument("experiment.sequences (--sequences): must be in [1, 2^32 - 1], got " + std::to_string(b.sequences));
+  pos("experiment.speed (--speed)", b.speed);
+  if (b.speed > kMaxBounceSpeed)
+    throw std::invalid_argument("experiment.speed (--speed): " + num(b.speed) + " m/s is outside the supported range (0, " + num(kMaxBounceSpeed) +
+                                "] m/s (the collision law of Eq. 9 is quasi-static: far below the speed of sound)");
+  if (!b.omega.allFinite()) throw std::invalid_argument("experiment.Omega: must be finite");
+  pos("experiment.stop_speed", b.stop_speed);
   if (!(b.stop_speed < b.speed))
-    throw std::invalid_argument("bounce: stop_speed " + num(b.stop_speed) + " must be below the first impact speed " + num(b.speed));
-  pos("gravity", b.gravity);
-  pos("density", b.density);
-  pos("beta", b.beta);
+    throw std::invalid_argument("experiment.stop_speed: " + num(b.stop_speed) + " must be below the first impact speed " + num(b.speed));
+  pos("experiment.gravity", b.gravity);
+  if (b.gravity < kMinGravity || b.gravity > kMaxGravity)
+    throw std::invalid_argument("experiment.gravity: " + num(b.gravity) + " m/s^2 is outside the supported range [" + num(kMinGravity) +
+                                ", " + num(kMaxGravity) + "] m/s^2 (1e-4 g to 1e3 g; the flight time 2 speed/gravity must stay resolvable)");
+  pos("material.density", b.density);
+  pos("material.restitution.beta", b.beta);
   if (!std::isfinite(b.eps_t) || b.eps_t < -1 || b.eps_t > 1) throw std::invalid_argument("bounce: eps_t must be in [-1, 1], got " + num(b.eps_t));
   validate(b.tangential);
   if (b.max_impacts < 1) throw std::invalid_argument("bounce: max_impacts must be >= 1");

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "asperity/core/random.hpp"
+#include "core/format.hpp"
 
 namespace asperity {
 
@@ -87,8 +88,7 @@ double binned_ks_distance(const BlockBins& b, const Cdf& cdf) {
   for (std::size_t j = 0; j < b.edges.size(); ++j) {
     const double f = cdf(b.edges[j]);
     if (!(f >= 0 && f <= 1))
-      throw std::invalid_argument("binned_ks_distance: cdf(" + std::to_string(b.edges[j]) + ") = " + std::to_string(f) +
-                                  " is not in [0, 1]");
+      throw std::invalid_argument("binned_ks_distance: cdf(" + detail::num(b.edges[j]) + ") = " + detail::num(f) + " is not in [0, 1]");
     d = std::max(d, std::abs(b.pooled[j] - f));
   }
   return d;

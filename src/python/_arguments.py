@@ -68,6 +68,10 @@ def _kind(value, typ):
     elif typ == "str":
         if not isinstance(value, str):
             return TypeError, "expected a string"
+        try:
+            value.encode("utf-8")
+        except UnicodeEncodeError:
+            return ValueError, "cannot be encoded as UTF-8 (a lone surrogate)"
     return None
 
 

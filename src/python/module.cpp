@@ -148,24 +148,69 @@ py::array_t<double> vectors_to_numpy(const std::vector<Vec3>& v, bool single) {
 
 // ---- scenes: a path, a preset name, or a dict in the scene-file layout ----
 
-// A scalar (bool, int, float, str, numpy scalar) handed to sink; false for anything else.
-template <class Sink>
-bool toml_scalar(const py::handle& h, Sink sink) {
-  if (py::isinstance<py::bool_>(h)) return sink(h.cast<bool>()), true;
-  if (py::isinstance<py::int_>(h)) {
-    // TOML integers are 64-bit: a larger one is out of every range the scene checks.
-    const auto o = py::reinterpret_borrow<py::int_>(h);
-    if (o < py::int_(std::numeric_limits<std::int64_t>::min()) || o > py::int_(std::numeric_limits<std::int64_t>::max()))
-      return sink(o.cast<double>()), true;
-    return sink(o.cast<std::int64_t>()), true;
+// A str as its UTF-8 bytes, or ValueError naming the parameter: a lone surrogate ('\\ud800') cannot
+// be encoded, and pybind11's own cast says "Unable to cast ..." without naming anything.
+std::string utf8_string(const py::handle& h, const std::string& name) {
+  Py_ssize_t n = 0;
+  const char* p = PyUnicode_AsUTF8AndSize(h.ptr(), &n);
+  if (p == nullptr) {
+    PyErr_Clear();
+    value_error(name + " = " + show(h) + ": cannot be encoded as UTF-8 (a lone surrogate)");
   }
-  if (py::isinstance<py::float_>(h)) return sink(h.cast<double>()), true;
-  if (py::isinstance<py::str>(h)) return sink(h.cast<std::string>()), true;
+  return std::string(p, static_cast<std::size_t>(n));
+}
+
+// A path (str, bytes or os.PathLike) as the bytes the file system sees, as open() takes it
+// (os.fsencode): a PathLike whose __fspath__ returns bytes is those bytes, not the text "b'...'".
+std::string path_bytes(const py::handle& h, const std::string& name) {
+  try {
+    return py::module_::import("os").attr("fsencode")(h).cast<std::string>();
+  } catch (py::error_already_set& e) {
+    if (e.matches(PyExc_UnicodeError)) value_error(name + " = " + show(h) + ": cannot be encoded as a file name (a lone surrogate)");
+    if (e.matches(PyExc_TypeError)) type_error(name + ": expected a path (str, bytes or os.PathLike), got " + show(h));
+    throw;
+  }
+}
+
+bool is_path(const py::handle& h) {
+  return py::isinstance<py::str>(h) || py::isinstance<py::bytes>(h) || py::hasattr(h, "__fspath__");
+}
+
+// True and False, numpy's too (numpy.bool_: no int, though it once had __index__).
+bool is_bool(const py::handle& h) {
+  if (py::isinstance<py::bool_>(h)) return true;
+  const std::string t = py::type::of(h).attr("__name__").cast<std::string>();
+  return (t == "bool_" || t == "bool") && py::type::of(h).attr("__module__").cast<std::string>() == "numpy";
+}
+
+// operator.index(h) (Python and numpy integers), or the TypeError it raised.
+py::int_ index_of(const py::handle& h) {
+  PyObject* i = PyNumber_Index(h.ptr());
+  if (i == nullptr) throw py::error_already_set();
+  return py::reinterpret_steal<py::int_>(i);
+}
+
+// A scalar (bool, int, float, str, numpy scalar) handed to sink; false for anything else. `key`
+// names it in errors.
+template <class Sink>
+bool toml_scalar(const py::handle& h, const std::string& key, Sink sink) {
+  if (is_bool(h)) return sink(PyObject_IsTrue(h.ptr()) == 1), true;
   if (py::isinstance<py::dict>(h) || py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h))
     return false;
+  if (py::isinstance<py::int_>(h) || (!py::isinstance<py::float_>(h) && !py::isinstance<py::str>(h) && py::hasattr(h, "__index__"))) {
+    // Python and numpy integers alike (numpy.uint64 too). TOML integers are 64-bit signed: a
+    // seed in [2^63, 2^64 - 1] is written as its digits (the scene reader takes a seed as a
+    // string of digits); anything larger is out of every range the scene checks.
+    const py::int_ o = index_of(h);
+    if (o >= py::int_(std::numeric_limits<std::int64_t>::min()) && o <= py::int_(std::numeric_limits<std::int64_t>::max()))
+      return sink(o.cast<std::int64_t>()), true;
+    if (o > py::int_(0) && o <= py::int_(std::numeric_limits<std::uint64_t>::max())) return sink(std::to_string(o.cast<std::uint64_t>())), true;
+    return sink(o.cast<double>()), true;
+  }
+  if (py::isinstance<py::float_>(h)) return sink(h.cast<double>()), true;
+  if (py::isinstance<py::str>(h)) return sink(utf8_string(h, "scene dict: " + key)), true;
   const auto o = py::reinterpret_borrow<py::object>(h);
-  if (py::hasattr(h, "__index__")) return sink(py::int_(o).cast<std::int64_t>()), true;  // numpy integers
-  if (py::hasattr(h, "__float__")) return sink(py::float_(o).cast<double>()), true;      // numpy floats
+  if (py::hasattr(h, "__float__")) return sink(py::float_(o).cast<double>()), true;  // numpy floats
   return false;
 }
 
@@ -173,39 +218,63 @@ bool is_sequence(const py::handle& h) {
   return py::isinstance<py::list>(h) || py::isinstance<py::tuple>(h) || py::isinstance<py::array>(h);
 }
 
-toml::table to_toml_table(const py::dict& d, const std::string& key);
+// The dict/list nesting allowed in a scene dict: the scene reader's limit (scene_file.cpp
+// kMaxNesting: arrays or inline tables at most 16 deep; a dotted key at most 16 parts). Checked
+// before recursing, so a dict that contains itself or a list nested 10^5 deep is a ValueError,
+// not a stack overflow. `path` holds the containers being converted, to name a cycle as one.
+constexpr std::size_t kMaxSceneDictNesting = 16;
 
-toml::array to_toml_array(const py::handle& h, const std::string& key) {
+struct Nesting {
+  std::vector<const PyObject*> path;
+  void enter(const py::handle& h, const std::string& key) {
+    for (const PyObject* p : path)
+      if (p == h.ptr()) value_error("scene dict: " + (key.empty() ? std::string("the dict") : key) + " contains itself (a cycle)");
+    if (path.size() >= kMaxSceneDictNesting)
+      value_error("scene dict: " + key + ": dicts and lists nested more than " + std::to_string(kMaxSceneDictNesting) +
+                  " deep (the scene reader's limit)");
+    path.push_back(h.ptr());
+  }
+  void leave() { path.pop_back(); }
+};
+
+toml::table to_toml_table(const py::dict& d, const std::string& key, Nesting& nest);
+
+toml::array to_toml_array(const py::handle& h, const std::string& key, Nesting& nest) {
+  nest.enter(h, key);
   toml::array a;
   py::list l = py::isinstance<py::array>(h) ? py::list(h.attr("tolist")()) : py::list(py::reinterpret_borrow<py::object>(h));
   for (std::size_t i = 0; i < l.size(); ++i) {
     const std::string k = key + "[" + std::to_string(i) + "]";
     const py::handle v = l[i];
-    if (toml_scalar(v, [&](auto&& x) { a.push_back(std::forward<decltype(x)>(x)); })) continue;
-    if (py::isinstance<py::dict>(v)) a.push_back(to_toml_table(v.cast<py::dict>(), k));
-    else if (is_sequence(v)) a.push_back(to_toml_array(v, k));
+    if (toml_scalar(v, k, [&](auto&& x) { a.push_back(std::forward<decltype(x)>(x)); })) continue;
+    if (py::isinstance<py::dict>(v)) a.push_back(to_toml_table(v.cast<py::dict>(), k, nest));
+    else if (is_sequence(v)) a.push_back(to_toml_array(v, k, nest));
     else value_error("scene dict: " + k + " = " + show(v) + ": not a bool, number, string, list or dict");
   }
+  nest.leave();
   return a;
 }
 
-toml::table to_toml_table(const py::dict& d, const std::string& key) {
+toml::table to_toml_table(const py::dict& d, const std::string& key, Nesting& nest) {
+  nest.enter(d, key);
   toml::table t;
   for (const auto& [k, v] : d) {
     if (!py::isinstance<py::str>(k)) value_error("scene dict: key " + show(k) + (key.empty() ? "" : " in " + key) + " is not a string");
-    const std::string name = k.cast<std::string>();
+    const std::string name = utf8_string(k, "scene dict: a key" + (key.empty() ? std::string() : " in " + key));
     const std::string full = key.empty() ? name : key + "." + name;
     if (v.is_none()) continue;  // None: the key is absent (its default)
-    if (toml_scalar(v, [&](auto&& x) { t.insert(name, std::forward<decltype(x)>(x)); })) continue;
-    if (py::isinstance<py::dict>(v)) t.insert(name, to_toml_table(v.cast<py::dict>(), full));
-    else if (is_sequence(v)) t.insert(name, to_toml_array(v, full));
+    if (toml_scalar(v, full, [&](auto&& x) { t.insert(name, std::forward<decltype(x)>(x)); })) continue;
+    if (py::isinstance<py::dict>(v)) t.insert(name, to_toml_table(v.cast<py::dict>(), full, nest));
+    else if (is_sequence(v)) t.insert(name, to_toml_array(v, full, nest));
     else value_error("scene dict: " + full + " = " + show(v) + ": not a bool, number, string, list or dict");
   }
+  nest.leave();
   return t;
 }
 
 std::string dict_to_toml(const py::dict& d) {
-  toml::table t = to_toml_table(d, "");
+  Nesting nest;
+  toml::table t = to_toml_table(d, "", nest);
   if (!t.contains("format")) t.insert("format", std::int64_t{kSceneFormatVersion});
   std::ostringstream s;
   s << t;
@@ -215,8 +284,8 @@ std::string dict_to_toml(const py::dict& d) {
 // SceneError and every other std::invalid_argument become ValueError (pybind11's translation).
 Scene to_scene(const py::handle& scene) {
   if (py::isinstance<py::dict>(scene)) return parse_scene(dict_to_toml(scene.cast<py::dict>()), "scene dict");
-  if (py::isinstance<py::str>(scene) || py::hasattr(scene, "__fspath__")) {
-    const std::string s = py::str(py::module_::import("os").attr("fspath")(scene)).cast<std::string>();
+  if (is_path(scene)) {
+    const std::string s = path_bytes(scene, "scene");
     std::error_code ec;
     if (std::filesystem::is_regular_file(s, ec)) return load_scene(s);
     for (const auto& p : preset_names())
@@ -294,9 +363,8 @@ bool apply_out(Scene& scene, const py::object& out) {
     return false;
   }
   if (py::isinstance<py::bool_>(out)) return true;  // True: the scene's outputs.dir
-  if (!py::isinstance<py::str>(out) && !py::hasattr(out, "__fspath__"))
-    type_error("out: expected None, True, False or a directory path, got " + show(out));
-  scene.out = py::str(py::module_::import("os").attr("fspath")(out)).cast<std::string>();
+  if (!is_path(out)) type_error("out: expected None, True, False or a directory path, got " + show(out));
+  scene.out = path_bytes(out, "out");
   if (scene.out.empty()) value_error("out: '' is not a directory name");
   return true;
 }
@@ -760,19 +828,18 @@ void bind_tables(py::module_& m) {
         spec.omega_bands = omega_bands;
         spec.probabilities = probabilities;
         if (!drops.is_none()) {
-          if (!py::isinstance<py::int_>(drops) || py::isinstance<py::bool_>(drops)) type_error("drops: expected an integer, got " + show(drops));
-          if (drops.cast<py::int_>() < py::int_(0) || drops.cast<py::int_>() > py::int_(std::uint64_t(-1)))
-            value_error("drops = " + show(drops) + ": expected a positive integer");
-          spec.drops = drops.cast<std::uint64_t>();
+          if (py::isinstance<py::bool_>(drops) || py::isinstance<py::float_>(drops) || !py::hasattr(drops, "__index__"))
+            type_error("drops: expected an integer, got " + show(drops));
+          const py::int_ d = index_of(drops);  // numpy integers too
+          if (d < py::int_(0) || d > py::int_(std::uint64_t(-1))) value_error("drops = " + show(drops) + ": expected a positive integer");
+          spec.drops = d.cast<std::uint64_t>();
         }
         validate(spec);
         check_bytes(cor_table_bytes(spec),
                     std::to_string(spec.drops) + " drops per speed, " + std::to_string(spec.probabilities) + " probabilities x " +
                         std::to_string(spec.speeds.size()) + " speeds",
                     "drops, probabilities, speeds, spins or omega_bands");
-        if (!path.is_none() && !py::isinstance<py::str>(path) && !py::hasattr(path, "__fspath__"))
-          type_error("path: expected None or a file path ending in .csv, got " + show(path));
-        const std::string file = path.is_none() ? std::string() : py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        const std::string file = path.is_none() ? std::string() : path_bytes(path, "path");
         if (!file.empty() && std::filesystem::path(file).extension() != ".csv")
           value_error("path = '" + file + "': must end in .csv (its header is written beside it as .json)");
         const Progress p = python_progress(progress);

@@ -76,12 +76,42 @@ TEST(Checkpoint, SigtermThenResumeEqualsTheUninterruptedRun) {
   r = run_command(vg() + " --resume " + cut.string() + " --drops 5 2>&1");
   EXPECT_EQ(r.status, 2) << r.out;
 
-  // Resumed with one thread: the same report as the whole run (timings aside), checkpoint gone.
-  r = run_command(vg() + " -q --resume " + cut.string() + " --threads 1 2>&1");
+  // Resumed with one thread and the scalar kernel (issue 33: --kernel scalar was refused as a
+  // "truncated" checkpoint): the same report as the whole run (timings aside), checkpoint gone.
+  r = run_command(vg() + " -q --resume " + cut.string() + " --threads 1 --kernel scalar 2>&1");
   EXPECT_EQ(r.status, whole_status) << r.out;
   EXPECT_FALSE(fs::exists(cut / "checkpoint.bin"));
   EXPECT_EQ(comparable_report(cut / "report.json"), comparable_report(whole / "report.json"));
   fs::remove_all(whole);
+  fs::remove_all(cut);
+  fs::remove(log);
+}
+
+// Issue 33 item 4: a streaming run into a non-ASCII --out can be resumed (checkpoint.toml holds the
+// path as \u escapes, which the ASCII scene reader accepts and turns back into the same bytes);
+// an --out that is not UTF-8 is refused before the run, naming the key, leaving nothing.
+TEST(Checkpoint, ANonAsciiOutputDirectoryResumes) {
+  const fs::path cut = fresh_dir("r\xc3\xa9sum\xc3\xa9");
+  const fs::path log = fresh_dir("resume-utf8").string() + ".log";
+  auto args = run_args(cut);
+  args.insert(args.end(), {"--checkpoint-every", "0.000001", "--threads", "2"});
+  const pid_t pid = spawn(args, log);
+  for (int i = 0; i < 6000 && !fs::exists(cut / "checkpoint.bin"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(fs::exists(cut / "checkpoint.bin")) << slurp(log);
+  ::kill(pid, SIGTERM);
+  ASSERT_EQ(wait_status(pid), 128 + SIGTERM) << slurp(log);
+  EXPECT_NE(slurp(cut / "checkpoint.toml").find("\\u00e9"), std::string::npos) << slurp(cut / "checkpoint.toml");
+  auto r = run_command(vg() + " -q --resume '" + cut.string() + "' --threads 1 2>&1");
+  EXPECT_TRUE(r.status == 0 || r.status == 1) << r.out;
+  EXPECT_FALSE(fs::exists(cut / "checkpoint.bin")) << r.out;
+  EXPECT_TRUE(fs::exists(cut / "report.json")) << r.out;
+  const fs::path bad = fresh_dir("bad\xff");
+  r = run_command(vg() + " -q --asperities 1000 --drops 4000 --no-plots --out '" + bad.string() + "' 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("outputs.dir (--out)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("not UTF-8"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(bad));
   fs::remove_all(cut);
   fs::remove(log);
 }

@@ -228,6 +228,14 @@ TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
       {"", "format = 1\n[outputs]\nreport = \"sub/r.json\"\n", "outputs.report"},
       // 9: duplicate variants
       {"--preset fig6 --variant paper,paper", "", "--variant: 'paper' is given twice"},
+      // issue 33 item 6: NaN reported with exit 0 (1e155, gravity 1e19, 5e-324) or an internal
+      // message (1e7): a bounce's stated ranges, key and value named
+      {"--preset fig6 --asperities 1000 --sequences 20 --speed 1e155", "", "experiment.speed (--speed): 1e+155 m/s is outside the supported range (0, 1000]"},
+      {"--preset fig6 --asperities 1000 --sequences 20 --speed 1e7", "", "experiment.speed (--speed): 1e+07 m/s is outside the supported range"},
+      {"", "format = 1\n[experiment]\nkind = \"bounce\"\ngravity = 1e19\n", ":4: experiment.gravity: 1e+19 m/s^2 is outside the supported range"},
+      {"", "format = 1\n[experiment]\nkind = \"bounce\"\ngravity = 5e-324\n", "gravity"},
+      {"", "format = 1\n[experiment]\nkind = \"bounce\"\nspeed = 1e155\n", ":4: experiment.speed"},
+      {"--omega-y 1e6", mesh_bounce_scene(), "must be <= 1000 m/s"},
       {"", "format = 1\n[experiment]\nkind = \"bounce\"\nvariants = \"dynamic,paper,dynamic\"\n", "experiment.variants"},
       // 10: integers as integers
       {"--seed \" -5\"", "", "--seed: ' -5'"},
@@ -340,6 +348,130 @@ TEST(CliOutput, SigintInTheMiddleOfABounceRunExits130AndLeavesNothing) {
   EXPECT_NE(slurp(log).find("interrupted by SIGINT"), std::string::npos) << slurp(log);
   EXPECT_FALSE(fs::exists(out)) << "the output directory must not be created by an interrupted run";
   fs::remove(log);
+}
+
+// Waits for the first progress line of a spawned run (after 1 s of running; at most 60 s).
+bool wait_running(const fs::path& log, const std::string& unit) {
+  for (int i = 0; i < 600; ++i) {
+    if (slurp(log).find(unit + ":") != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+// Issue 33 item 3: an output directory belongs to one run at a time. A second run into a directory
+// where a run is under way is refused up front (exit 2, "in use"), so it can never remove the first
+// run's checkpoint when it ends; the first run, ended by SIGQUIT, SIGALRM, SIGXCPU or SIGXFSZ (each
+// handled as SIGTERM is), leaves nothing behind and exits 128 + signal.
+TEST(CliOutput, OneRunAtATimeInADirectoryAndEveryFatalSignalCleansUp) {
+  const fs::path out = fresh_dir("locked");
+  const fs::path log = out.string() + ".log";
+  for (int sig : {SIGQUIT, SIGALRM, SIGXCPU, SIGXFSZ}) {
+    fs::remove(log);  // the previous run's progress line must not be taken for this one's
+    const pid_t pid = spawn({"--preset", "fig6", "--variant", "dynamic", "--sequences", "50000", "--no-plots", "--out", out.string()}, log);
+    const bool running = wait_running(log, "sequences");
+    if (running && sig == SIGQUIT) {
+      const auto r = run_command(vg() + " -q --asperities 1000 --drops 2000 --no-plots --out " + out.string() + " 2>&1");
+      EXPECT_EQ(r.status, 2) << r.out;
+      EXPECT_NE(r.out.find("is in use by another run"), std::string::npos) << r.out;
+    }
+    ::kill(pid, sig);
+    const int status = wait_status(pid);
+    ASSERT_TRUE(running) << slurp(log);
+    EXPECT_EQ(status, 128 + sig) << sig << ": " << slurp(log);
+    EXPECT_NE(slurp(log).find("interrupted by SIG"), std::string::npos) << slurp(log);
+    EXPECT_FALSE(fs::exists(out)) << sig << ": the run's staging and output directories must be gone";
+  }
+  fs::remove(log);
+}
+
+// Issue 33 item 7: what can be checked before the computation is checked before it. A report.json
+// planted as a symbolic link is refused up front (it was found at commit time, after the whole
+// run): the run here would take many minutes, so an answer within 60 s is one given before it.
+TEST(CliOutput, APlantedReportLinkIsRefusedBeforeTheRun) {
+  const fs::path out = fresh_dir("planted");
+  fs::create_directories(out);
+  fs::create_symlink("/tmp/asperity-planted-target", out / "report.json");
+  const auto before = std::chrono::steady_clock::now();
+  const auto r = run_command(vg() + " --asperities 1000 --drops 2000000000 --statistics streaming --no-plots --out " +
+                             out.string() + " 2>&1");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - before).count();
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("report.json"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("a symbolic link"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("drops:"), std::string::npos) << "the run started: " << r.out;
+  EXPECT_LT(seconds, 60) << r.out;
+  EXPECT_TRUE(fs::is_symlink(out / "report.json"));
+  EXPECT_FALSE(fs::exists("/tmp/asperity-planted-target"));
+  fs::remove_all(out);
+}
+
+// Issue 33 item 8: a scene name or key holding terminal escape sequences is shown escaped (\x1b),
+// never written raw to the terminal (ESC [2J cleared the screen); the name in report.json is kept.
+TEST(CliOutput, EscapeSequencesInNamesAndKeysAreShownEscaped) {
+  const fs::path dir = fresh_dir("escapes");
+  fs::create_directories(dir);
+  std::ofstream(dir / "named.toml") << "format = 1\nname = \"x\\u001b[2Jy\\u009bz\"\n[asperities]\ncount = 500\n"
+                                       "[ensemble]\ndrops = 500\n[outputs]\nplots = false\n";
+  std::ofstream(dir / "key.toml") << "format = 1\n\"k\\u001b]0;title\\u0007\" = 1\n";
+  auto r = run_command(vg() + " --scene " + (dir / "named.toml").string() + " --out " + (dir / "out").string() + " 2>&1");
+  EXPECT_TRUE(r.status == 0 || r.status == 1) << r.out;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("\xc2\x9b"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("x\\x1b[2Jy\\xc2\\x9bz"), std::string::npos) << r.out;
+  r = run_command(vg() + " --scene " + (dir / "key.toml").string() + " --out " + (dir / "out2").string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_EQ(r.out.find('\x1b'), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find('\x07'), std::string::npos) << r.out;
+  fs::remove_all(dir);
+}
+
+// Issue 33 item 6: --preset fig4 --omega-x 1e-5 skipped every Eq. 28 law, the decisive one too,
+// because Eq. 28 as printed (an info law) is NaN at that spin and the laws of a quantity were
+// tested together. Each law is now evaluated alone: the printed one is skipped, eq28-corrected
+// decides (and the run would have said so in its verdict and exit status).
+TEST(CliRefusals, OneLawThatCannotBeEvaluatedSkipsOnlyItself) {
+  const fs::path out = fresh_dir("tiny-spin");
+  const auto r = run_command(vg() + " -q --preset fig4 --asperities 1000 --drops 20000 --omega-x 1e-5 --no-plots --out " +
+                             out.string() + " 2>&1");
+  EXPECT_TRUE(r.status == 0 || r.status == 1) << r.out;
+  const std::string report = slurp(out / "report.json");
+  const auto row = [&](const std::string& law) {  // the verdict of the eps row of `law`
+    const auto at = report.find("\"law\": \"" + law + "\",\n      \"n\"");  // keys are sorted: verdict follows
+    const auto v = report.find("\"verdict\": \"", at);
+    return at == std::string::npos ? std::string("absent") : report.substr(v + 12, report.find('"', v + 12) - v - 12);
+  };
+  EXPECT_NE(row("eq28-corrected"), "skipped") << report.substr(0, 200);
+  EXPECT_NE(row("eq28-corrected"), "absent");
+  EXPECT_EQ(r.out.find("eq28-corrected (skipped)"), std::string::npos) << r.out;
+  fs::remove_all(out);
+}
+
+// Issue 33 item 8: kill -9 leaves a staging directory no handler could remove; the next run in the
+// directory removes those of dead processes only -- never a live process's, a link, or a file.
+TEST(CliOutput, StagingDirectoriesOfDeadRunsAreRemovedByTheNextRun) {
+  const fs::path out = fresh_dir("stale");
+  fs::create_directories(out);
+  const pid_t dead = ::fork();
+  if (dead == 0) ::_exit(0);
+  ASSERT_EQ(wait_status(dead), 0);
+  const std::string stale = ".asperity-staging-" + std::to_string(dead) + "-dead";
+  const std::string live = ".asperity-staging-" + std::to_string(::getpid()) + "-live";
+  fs::create_directories(out / stale / "sub");
+  std::ofstream(out / stale / "sub" / "r_x.csv") << "partial";
+  fs::create_directories(out / live);
+  std::ofstream(out / (".asperity-staging-" + std::to_string(dead) + "-file")) << "not a directory";
+  fs::create_directories(out.string() + "-target");
+  fs::create_directory_symlink(out.string() + "-target", out / (".asperity-staging-" + std::to_string(dead) + "-link"));
+  const auto r = run_command(vg() + " -q --asperities 1000 --drops 2000 --no-plots --out " + out.string() + " 2>&1");
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_FALSE(fs::exists(out / stale)) << "a dead run's staging directory stays";
+  EXPECT_TRUE(fs::is_directory(out / live)) << "a live process's staging directory was removed";
+  EXPECT_TRUE(fs::is_regular_file(out / (".asperity-staging-" + std::to_string(dead) + "-file")));
+  EXPECT_TRUE(fs::is_symlink(out / (".asperity-staging-" + std::to_string(dead) + "-link")));
+  EXPECT_TRUE(fs::is_directory(out.string() + "-target"));
+  fs::remove_all(out);
+  fs::remove_all(out.string() + "-target");
 }
 
 namespace {

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -120,6 +121,74 @@ TEST(MeshBounds, HeaderCountsMustFitTheFile) {
   EXPECT_NE(message_of([&] { read_mesh(d / "fifo.off"); }).find("not a regular file"), std::string::npos);
   // A real mesh of the source tree still reads.
   EXPECT_EQ(message_of([] { read_mesh(fs::path(MESHES_DIR) / "icosphere.off"); }), "");
+  fs::remove_all(d);
+}
+
+// Issue 33 item 2: a 227-byte PLY whose header passes (4 vertices, 4 faces) but whose first face
+// claims 4e9 indices made CGAL allocate 12.7 GB before reading one. Every list count is bounded by
+// the bytes after it and by the vertex count, ASCII and binary, PLY and OFF; the same tetrahedron
+// with honest counts still reads (so the check is not "refuse every list").
+namespace {
+const char* kTetraVertices = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+std::string tetra_ply_ascii(const std::string& first_face) {
+  return "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+         "element face 4\nproperty list uchar int vertex_indices\nend_header\n" +
+         std::string(kTetraVertices) + first_face + "\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+}
+// Binary little endian, count type `count` (uint32 here: 4 bytes) and int indices.
+std::string tetra_ply_binary(std::uint32_t first_count, bool big_endian) {
+  std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                  " 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+                  "element face 4\nproperty list uint int vertex_indices\nend_header\n";
+  auto put32 = [&](std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) s += static_cast<char>((v >> (8 * (big_endian ? 3 - i : i))) & 0xff);
+  };
+  const float xyz[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (const auto& v : xyz)
+    for (float c : v) {
+      std::uint32_t bits = 0;
+      std::memcpy(&bits, &c, 4);
+      put32(bits);
+    }
+  const std::uint32_t faces[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  for (int f = 0; f < 4; ++f) {
+    put32(f == 0 ? first_count : 3);
+    for (auto i : faces[f]) put32(i);
+  }
+  return s;
+}
+}  // namespace
+
+TEST(MeshBounds, ListCountsMustFitTheFile) {
+  const fs::path d = fresh_dir("bounds", "mesh-lists");
+  fs::create_directories(d);
+  const std::string bad = tetra_ply_ascii("4000000000 0 2 1");
+  EXPECT_LT(bad.size(), 260u);
+  write(d / "claims.ply", bad);
+  std::string m = message_of([&] { read_mesh(d / "claims.ply"); });
+  EXPECT_NE(m.find("face 0 'vertex_indices' claims 4000000000 entries"), std::string::npos) << m;
+  write(d / "corners.ply", tetra_ply_ascii("40 0 2 1 " + std::string(80, ' ')));  // fits the bytes, not the 4 vertices
+  m = message_of([&] { read_mesh(d / "corners.ply"); });
+  EXPECT_NE(m.find("more corners than the mesh's 4 vertices"), std::string::npos) << m;
+  write(d / "ok.ply", tetra_ply_ascii("3 0 2 1"));
+  EXPECT_EQ(message_of([&] { read_mesh(d / "ok.ply"); }), "");
+  for (bool big : {false, true}) {
+    write(d / "claims_bin.ply", tetra_ply_binary(4000000000u, big));
+    m = message_of([&] { read_mesh(d / "claims_bin.ply"); });
+    EXPECT_NE(m.find("claims 4000000000 entries"), std::string::npos) << big << ": " << m;
+    write(d / "neg_bin.ply", tetra_ply_binary(0xffffffffu, big));  // -1 as a signed count
+    EXPECT_NE(message_of([&] { read_mesh(d / "neg_bin.ply"); }).find("claims"), std::string::npos) << big;
+    write(d / "ok_bin.ply", tetra_ply_binary(3, big));
+    EXPECT_EQ(message_of([&] { read_mesh(d / "ok_bin.ply"); }), "") << big;
+  }
+  const std::string off = "OFF\n4 4 0\n" + std::string(kTetraVertices);
+  write(d / "claims.off", off + "4000000000 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  m = message_of([&] { read_mesh(d / "claims.off"); });
+  EXPECT_NE(m.find("face 0 claims 4000000000 entries"), std::string::npos) << m;
+  write(d / "ok.off", off + "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n");
+  EXPECT_EQ(message_of([&] { read_mesh(d / "ok.off"); }), "");
+  write(d / "bin.off", "OFF BINARY\n");
+  EXPECT_NE(message_of([&] { read_mesh(d / "bin.off"); }).find("binary OFF"), std::string::npos);
   fs::remove_all(d);
 }
 

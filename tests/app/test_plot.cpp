@@ -150,7 +150,7 @@ TEST(Plot, FormatsParseAndRefuse) {
   EXPECT_EQ(to_string(parse_plot_formats("png+pdf")), "png+pdf");
   EXPECT_EQ(to_string(parse_plot_formats("svg")), "svg");
   for (const char* bad : {"", "jpg", "png+", "+png", "png+png", "PNG", "png pdf", "png@", "png@0.2", "png@9", "png@2x",
-                          "png@nan", "@2"})
+                          "png@nan", "@2", "png@0x2", "png@ 2", "png@+2", "png@2 ", "png@inf"})
     EXPECT_THROW(parse_plot_formats(bad), std::invalid_argument) << bad;
   EXPECT_EQ(parse_plot_formats("png+svg@2.5").scale, 2.5);
   EXPECT_EQ(to_string(parse_plot_formats("png+svg@2.5")), "png+svg@2.5");

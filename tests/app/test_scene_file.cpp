@@ -549,3 +549,39 @@ TEST(SceneFile, BounceGroupsAreSelectable) {
   expect_error(replace(base, "sequences = 20", "sequences = 20\nimpact_groups = [2.5]"), "experiment.impact_groups", "whole");
   expect_error(replace(kGood, "V = [0.0, 0.0, -1.3]", "V = [0.0, 0.0, -1.3]\nimpact_groups = [1]"), "experiment.impact_groups", "bounce");
 }
+
+// Issue 33 item 4: any byte a POSIX path may hold (all but '/' and NUL) either round-trips through
+// to_toml and the scene reader -- what checkpoint.toml does for --resume -- or is refused by
+// validate, naming the key, before any run. Non-ASCII UTF-8 (résumé, CJK, emoji) round-trips;
+// bytes that are not UTF-8 are refused (TOML and JSON hold UTF-8 only). A refusal of every
+// non-ASCII name would fail the first half, a round-trip that drops bytes the second.
+TEST(SceneFile, EveryPathByteRoundTripsThroughTomlOrIsRefusedUpFront) {
+  std::vector<std::string> names;
+  for (int b = 1; b < 256; ++b)
+    if (b != '/') names.push_back("out" + std::string(1, static_cast<char>(b)) + "x");
+  for (const char* utf8 : {"r\xc3\xa9sum\xc3\xa9", "\xe6\x97\xa5\xe6\x9c\xac", "\xf0\x9f\x98\x80", "a\\b\"c"})
+    names.push_back(utf8);
+  int round_trips = 0, refused = 0;
+  for (const std::string& name : names) {
+    Scene s = preset("fig4");
+    s.out = name;
+    std::string why;
+    try {
+      validate(s);
+    } catch (const std::invalid_argument& e) {
+      why = e.what();
+    }
+    if (!why.empty()) {
+      ++refused;
+      EXPECT_NE(why.find("outputs.dir (--out)"), std::string::npos) << why;
+      EXPECT_NE(why.find("not UTF-8"), std::string::npos) << why;
+      continue;
+    }
+    ++round_trips;
+    const std::string text = to_toml(s);
+    for (char c : text) ASSERT_LT(static_cast<unsigned char>(c), 0x80) << "to_toml wrote a non-ASCII byte for " << name;
+    EXPECT_EQ(parse_scene(text, "checkpoint.toml").out.string(), name);
+  }
+  EXPECT_EQ(refused, 128) << "the bytes 0x80..0xff alone are not UTF-8";
+  EXPECT_EQ(round_trips, static_cast<int>(names.size()) - 128);
+}

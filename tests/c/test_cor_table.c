@@ -221,6 +221,9 @@ static void check_files(void) {
   CHECK(asperity_cor_load(&t, path, err, sizeof err) == -1 && strstr(err, "NUL byte") && strstr(err, path));
   remove(path);
   CHECK(asperity_cor_load(&t, "/nonexistent/table.csv", err, sizeof err) == -1 && strstr(err, "/nonexistent/table.csv"));
+  /* Issue 33 item 8: sampling the table a failed load left empty is NAN, not a NULL dereference. */
+  CHECK(isnan(asperity_cor_sample(&t, 1.0, 0.5)) && isnan(asperity_cor_sample_spin(&t, 0.0, 1.0, 0.5)));
+  CHECK(isnan(asperity_cor_sample_omega(&t, 0.0, 1.0, 0.5, 0.5)) && isnan(asperity_cor_sample(NULL, 1.0, 0.5)));
 #if defined(__unix__) || defined(__APPLE__)
   CHECK(asperity_cor_load(&t, ".", err, sizeof err) == -1 && strstr(err, "not a regular file"));
   CHECK(asperity_cor_load(&t, "/dev/zero", err, sizeof err) == -1 && strstr(err, "not a regular file"));

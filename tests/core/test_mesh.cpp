@@ -216,5 +216,17 @@ TEST(Mesh, PlyExport) {
   EXPECT_NE(all.find("element face " + std::to_string(nf) + "\n"), std::string::npos);
   EXPECT_EQ(lines - header, nv + nf);
   EXPECT_THROW(write_ply(dir / "x.ply", b, PlyStyle::spheres, -1.0), std::invalid_argument);
+  // Issue 33 item 5: the body's name (its mesh file's) cannot write header lines of its own: a
+  // newline, a control character, a backslash or a non-ASCII byte is escaped in the comment line.
+  RoughBody named = b;
+  named.name = "ply\nelement vertex 0\nend_header\x1b[2J\\\xc3\xa9.off";
+  write_ply(dir / "named.ply", named, PlyStyle::points);
+  std::ifstream nin(dir / "named.ply");
+  std::vector<std::string> head;
+  for (std::string l; std::getline(nin, l) && l != "end_header";) head.push_back(l);
+  ASSERT_EQ(head.size(), 8u) << "one comment line, no injected lines";
+  EXPECT_EQ(head[2], "comment asperity rough body 'ply\\x0aelement vertex 0\\x0aend_header\\x1b[2J\\\\\\xc3\\xa9.off', body frame, metres");
+  for (const auto& l : head)
+    for (char c : l) EXPECT_LT(static_cast<unsigned char>(c), 0x80) << l;
   std::filesystem::remove_all(dir);
 }

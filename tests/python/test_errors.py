@@ -94,6 +94,20 @@ CASES = [
     ("asperity.cor_table(probabilities=-3)", "ValueError", "probabilities"),
     ("asperity.run({'ensemble': {'drops': -1}})", "ValueError", "drops"),
     ("asperity.run({'asperities': {'radius': {'distribution': 'fixed', 'value': float('nan')}}})", "ValueError", "radius"),
+    # issue 33 item 1: recursive and very deep scene dicts are refused before the conversion
+    # recurses (a segfault before), at the scene reader's nesting limit of 16
+    ("asperity.run((lambda d: (d.__setitem__('x', d), d)[1])({'format': 1}))", "ValueError", "contains itself"),
+    ("asperity.scene_toml({'a': (lambda l: (l.append(l), l)[1])([])})", "ValueError", "a[0] contains itself"),
+    ("asperity.scene_toml({'a': __import__('functools').reduce(lambda a, _: [a], range(10**5), 0)})", "ValueError",
+     "nested more than 16 deep"),
+    ("asperity.scene_toml(__import__('functools').reduce(lambda a, _: {'k': a}, range(10**5), 0))", "ValueError",
+     "nested more than 16 deep"),
+    # issue 33 item 8: a lone surrogate names its parameter or key; a bytes __fspath__ is a path
+    ("asperity.preset_text('\\ud800')", "ValueError", "name"),
+    ("asperity.scene_toml('\\ud800')", "ValueError", "scene"),
+    ("asperity.scene_toml({'name': '\\ud800'})", "ValueError", "scene dict: name"),
+    ("asperity.scene_toml({'\\ud800': 1})", "ValueError", "scene dict: a key"),
+    ("asperity.run('fig4', out='\\ud800')", "ValueError", "out"),
 ]
 
 # One child interpreter runs every call in turn and prints one JSON line per call: an abort stops
@@ -143,3 +157,56 @@ def test_a_bad_call_is_an_exception_naming_the_parameter(call, kind, named, outc
     assert got == kind, f"{call}: {got}: {message}"
     assert named in message, f"{call}: the message does not name {named!r}: {message}"
     assert not (tmp / "out").exists(), f"{call}: a refused run created its output directory"
+
+
+# Issue 33: the scene-dict entry points (asperity.scene_toml, the conversion asperity.run uses)
+# against random Python objects -- nesting up to 24 deep, cycles, lone surrogates, numpy scalars,
+# integers beyond 64 bits, NaN, bytes, None -- in a child interpreter (seeded, 3000 inputs): every
+# input is either converted or refused with TypeError/ValueError; anything else (a crash, another
+# exception type) fails. A bounded, reproducible stand-in for fuzzing the Python entry points.
+FUZZ_CHILD = textwrap.dedent("""
+    import json, random, sys
+    import numpy as np
+    import asperity
+    rng = random.Random(33)
+    KEYS = ["format", "name", "body", "asperities", "count", "ensemble", "seed", "drops", "experiment",
+            "kind", "outputs", "plots", "\\ud800", "x" * 40, "", "a.b"]
+    def scalar():
+        return rng.choice([0, 1, -1, 2**63, 2**64 - 1, 2**64, 10**30, 1.5, float("nan"), float("inf"), True,
+                           None, "fig4", "\\ud800", "\\x1b[2J", b"bytes", np.uint64(2**64 - 1), np.int32(-5),
+                           np.float64(2.5), np.bool_(True), object()])
+    def value(depth):
+        r = rng.random()
+        if depth > 24 or r < 0.5:
+            return scalar()
+        if r < 0.75:
+            return {rng.choice(KEYS): value(depth + 1) for _ in range(rng.randint(0, 3))}
+        return [value(depth + 1) for _ in range(rng.randint(0, 3))]
+    counts = {}
+    for i in range(3000):
+        v = value(0)
+        if not isinstance(v, dict):
+            v = {rng.choice(KEYS): v}
+        if rng.random() < 0.05:
+            v["self"] = v
+        try:
+            asperity.scene_toml(v)
+            kind = "ok"
+        except (TypeError, ValueError) as e:
+            kind = type(e).__name__
+        except BaseException as e:
+            print(json.dumps(["unexpected", i, type(e).__name__, str(e)[:200]]), flush=True)
+            sys.exit(3)
+        counts[kind] = counts.get(kind, 0) + 1
+    print(json.dumps(counts), flush=True)
+""")
+
+
+def test_random_scene_dicts_convert_or_raise_type_or_value_error(tmp_path):
+    package = os.path.dirname(os.path.dirname(os.path.abspath(asperity.__file__)))
+    env = dict(os.environ, OMP_NUM_THREADS="2", PYTHONPATH=package)
+    r = subprocess.run([sys.executable, "-c", FUZZ_CHILD], capture_output=True, text=True, timeout=300, env=env, cwd=tmp_path)
+    assert r.returncode == 0, f"status {r.returncode}: {r.stdout[-2000:]} {r.stderr[-2000:]}"
+    counts = json.loads(r.stdout.strip().splitlines()[-1])
+    assert sum(counts.values()) == 3000
+    assert counts.get("ok", 0) > 0 and counts.get("ValueError", 0) > 0, counts  # both outcomes reached

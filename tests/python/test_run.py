@@ -207,3 +207,33 @@ def test_run_writes_no_file_unless_asked(small_scene, tmp_path, monkeypatch):
         asperity.run(table)
     with pytest.raises(TypeError, match="out"):
         asperity.run(scene, out=3)
+
+
+def test_numpy_integers_big_seeds_and_bytes_paths_are_accepted(tmp_path, monkeypatch):
+    """Issue 33 item 8: what Python users pass is taken as meant -- numpy integers (numpy.uint64
+    included) in a scene dict, a seed up to 2**64 - 1 (2**63 was refused as a float), and an
+    os.PathLike whose __fspath__ returns bytes (it wrote into a directory named "b'bp'")."""
+    for seed in (2**63, 2**64 - 1, np.uint64(2**64 - 1)):
+        text = asperity.scene_toml({"ensemble": {"seed": seed}})
+        assert f'seed = "{int(seed)}"' in text, text
+    assert "seed = 7\n" in asperity.scene_toml({"ensemble": {"seed": np.int32(7)}})
+    assert "count = 500\n" in asperity.scene_toml({"asperities": {"count": np.uint64(500)}})
+    with pytest.raises(ValueError, match="seed"):
+        asperity.scene_toml({"ensemble": {"seed": 2**64}})
+
+    class BytesPath:
+        def __init__(self, b):
+            self.b = b
+
+        def __fspath__(self):
+            return self.b
+
+    scene_file = tmp_path / "s.toml"
+    scene_file.write_text(asperity.preset_text("fig4"))
+    assert asperity.scene_toml(BytesPath(os.fsencode(scene_file))) == asperity.scene_toml(str(scene_file))
+    monkeypatch.chdir(tmp_path)
+    scene = preset_dict("fig3")
+    scene["ensemble"].update(drops=4000, spheres=4)
+    scene["outputs"].update(plots=True)
+    r = asperity.run(scene, arrays=False, out=BytesPath(b"bp"))
+    assert r["plots"] and (tmp_path / "bp").is_dir() and not (tmp_path / "b'bp'").exists()

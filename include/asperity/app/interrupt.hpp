@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 #pragma once
 // What a run leaves behind when it is interrupted: nothing. install_interrupt_cleanup() makes
-// SIGINT, SIGTERM, SIGHUP and SIGPIPE remove the registered temporary files and directories
+// SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGQUIT, SIGALRM, SIGXCPU and SIGXFSZ remove the registered temporary files and directories
 // (their files, then themselves) and the registered output directories the run created (only if
 // empty), and exit with status 128 + signal number. The
 // handler uses async-signal-safe system calls only; registration is lock-free. Without

@@ -56,6 +56,19 @@ std::string_view to_string(BounceVariant v);
 /// "paper", "paper-printed33", "random-orientation", "dynamic", "paper-corrected28"; throws std::invalid_argument naming the value.
 BounceVariant parse_bounce_variant(std::string_view s);
 
+/// Stated ranges of a bounce sequence (validate): where its model and its numbers hold.
+/// Speed: the viscoelastic collision law of Eq. 9 is quasi-static, valid far below the speed of
+/// sound in the bodies (~10^3 m/s to ~6*10^3 m/s for metals and glass); at 1e7 m/s the statistics of
+/// a sequence reached NaN (exit 2 with an internal message) and at 1e155 the squared speed
+/// overflowed (NaN reported with exit 0, issue 33 item 6). The same bound holds for the spin's
+/// surface speed |Omega|(R + a) (checked with the body's size, scene.cpp).
+inline constexpr double kMaxBounceSpeed = 1e3;
+/// Gravity: from 1e-3 m/s^2 (1e-4 g) to 1e4 m/s^2 (1e3 g). Each flight lasts 2 u / g and the
+/// body turns freely meanwhile: at the ends of these ranges a flight lasts at most 2e6 s; below
+/// them (5e-324 m/s^2) the flight time overflowed, above them (1e19) it vanished below the
+/// resolution of the impact times.
+inline constexpr double kMinGravity = 1e-3, kMaxGravity = 1e4;
+
 struct BounceExperiment {
   bool enabled = false;
   std::vector<BounceVariant> variants{BounceVariant::paper, BounceVariant::random_orientation, BounceVariant::dynamic};

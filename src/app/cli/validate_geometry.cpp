@@ -34,6 +34,7 @@
 #include "app/cli/options.hpp"
 #include "app/cli/processes.hpp"
 #include "app/cli/progress_line.hpp"
+#include "app/text_escape.hpp"
 
 namespace fs = std::filesystem;
 using namespace asperity;
@@ -80,9 +81,20 @@ std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& 
   return std::nullopt;
 }
 
+// Text for the terminal: a scene name or key can hold escape sequences (ESC [2J clears the
+// screen, OSC sequences set the title or write to the clipboard); every control character but
+// the line breaks of a multi-line table or message is shown as \xNN (issue 33 item 8).
+std::string shown(const std::string& text) {
+  std::string out;
+  std::size_t from = 0;
+  for (std::size_t nl; (nl = text.find('\n', from)) != std::string::npos; from = nl + 1)
+    out += asperity::detail::escaped(std::string_view(text).substr(from, nl - from)) + "\n";
+  return out + asperity::detail::escaped(std::string_view(text).substr(from));
+}
+
 // The table, the files written, and a warning for every decisive test that was skipped.
 void print_outcome(const Scene& scene, const SceneOutput& r, const std::vector<fs::path>& reports) {
-  std::cout << r.table;
+  std::cout << shown(r.table);
   std::cout << "wrote " << (scene.out / scene.report).string() << ", " << reports.at(1).filename().string();
   for (const auto& f : r.files) std::cout << ", " << f;
   std::cout << "\n";
@@ -111,6 +123,24 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir, Collect
     throw BadInput(std::string("--out: ") + ex.what());
   }
   staging_dir = staging->dir().string();
+  // The report and its table cannot be renamed over a link or a directory: found now, before the
+  // run, not at commit time after it (issue 33 item 7).
+  try {
+    std::vector<std::string> known{scene.report, report_table_name(scene.report)};
+    if (scene.mesh && !scene.mesh->export_ply.empty()) known.push_back(scene.mesh->export_ply);
+    staging->check_replaceable(known);
+  } catch (const std::exception& ex) {
+    throw BadInput(ex.what());
+  }
+  // Checked again under the directory's lock: a run that ended between check_run and the lock
+  // may have left its checkpoint here, which this run must neither overwrite nor remove.
+  if (!scene.resume && uses_streaming(scene.ensemble)) {
+    try {
+      check_checkpoint_files(scene);
+    } catch (const std::exception& ex) {
+      throw BadInput(ex.what());
+    }
+  }
   const bool sequences = run_kind(scene) == RunKind::mesh_bounce || run_kind(scene) == RunKind::bounce;
   ProgressLine progress(!quiet, stderr, ::isatty(2) != 0, &ProgressLine::steady_seconds, 1.0,
                         sequences ? "sequences" : "drops");
@@ -122,8 +152,9 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir, Collect
   staging->add(reports.at(1).filename().string());  // the table, then the report last
   staging->add(reports.at(0).filename().string());
   staging->commit();
+  // Under the lock still: this run's checkpoint (or the one it continued), no other run's.
+  if (uses_streaming(scene.ensemble)) remove_checkpoint(scene.out, scene.share);
   staging.reset();
-  if (uses_streaming(scene.ensemble)) remove_checkpoint(scene.out, scene.share);  // this run's (or the run it continued)
   print_outcome(scene, r, reports);
   return r.rejected ? 1 : 0;
 }
@@ -146,7 +177,7 @@ int run_reporting(const Scene& scene, bool quiet, Collective* group) {
               << scene.out.string() << " is as it was\n";
     return 2;
   } catch (const std::exception& ex) {
-    std::cerr << "validate-geometry: error: " << in_place(ex.what(), staging_dir, scene.out) << "\n";
+    std::cerr << "validate-geometry: error: " << shown(in_place(ex.what(), staging_dir, scene.out)) << "\n";
     return 2;
   }
 }
@@ -211,7 +242,7 @@ int run_main(int argc, char** argv) {
   try {
     world = cli::join_processes(&argc, &argv);
   } catch (const std::exception& ex) {
-    std::cerr << "validate-geometry: error: " << ex.what() << "\n";
+    std::cerr << "validate-geometry: error: " << shown(ex.what()) << "\n";
     return 2;
   }
   const StreamShare share = world ? StreamShare{world->rank(), world->size()} : StreamShare{};
@@ -227,11 +258,11 @@ int run_main(int argc, char** argv) {
     const bool rank0_failed = world->max(share.rank == 0 && !error.empty()) != 0;
     if (!error.empty() && (share.rank == 0 || !rank0_failed))
       std::cerr << "validate-geometry: error" << (share.rank > 0 ? " (rank " + std::to_string(share.rank) + ")" : "")
-                << ": " << error << "\n";
+                << ": " << shown(error) << "\n";
     return status && *status == 0 ? 0 : 2;
   }
   if (status) {
-    if (!error.empty()) std::cerr << "validate-geometry: error: " << error << "\n";
+    if (!error.empty()) std::cerr << "validate-geometry: error: " << shown(error) << "\n";
     return *status;
   }
   if (world) return run_split(scene, quiet, *world);
