@@ -6,8 +6,9 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
-#include "asperity/app/scene.hpp"
+#include "asperity/app/plan.hpp"
 
 namespace asperity::cli {
 
@@ -18,6 +19,10 @@ struct BadInput : std::runtime_error {
 
 struct Options {
   Scene scene;             ///< validated (asperity::validate) unless `help`
+  RunControl control;      ///< --resume, --checkpoint-every (the share is the caller's)
+  /// The options given that act on streaming statistics only (--checkpoint-every, --bins-log2):
+  /// validate-geometry refuses them when the run's plan keeps raw samples.
+  std::vector<std::string> streaming_only;
   bool quiet = false;      ///< --quiet: no progress lines
   bool help = false;       ///< --help or --version was given: print help_text, exit 0, nothing else
   std::string help_text;
