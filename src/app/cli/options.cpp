@@ -551,8 +551,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   if (given("--tangential")) apply_tangential_option(scene, r, k);
   apply_streaming_options(scene, control, r, given, k);
   apply_run_options(scene, r, given);
-  validate(scene);
-  return scene;
+  return scene;  // the cross-key rules: plan() (plan.hpp), once per run
 }
 
 }  // namespace
