@@ -306,9 +306,10 @@ void write_scene_cor_table(const Scene& s, const Progress& progress, const std::
   o.table += line.str();
 }
 
-SceneOutput run_sphere(const Plan& p, const Progress& progress, const std::filesystem::path& dir, Collective* group) {
+SceneOutput run_sphere(const Plan& p, const Progress& progress, const std::filesystem::path& dir, Collective* group,
+                       ContactSamples* keep) {
   const Scene& s = p.given;
-  const GeometryReport r = run_scene(p, progress, dir, group);
+  const GeometryReport r = run_scene(p, progress, dir, group, keep);
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
@@ -327,12 +328,13 @@ SceneOutput run_sphere(const Plan& p, const Progress& progress, const std::files
 
 }  // namespace
 
-GeometryReport run_scene(const Plan& p, const Progress& progress, const std::filesystem::path& dir, Collective* group) {
+GeometryReport run_scene(const Plan& p, const Progress& progress, const std::filesystem::path& dir, Collective* group,
+                         ContactSamples* keep) {
   if (p.streams) return run_stream_scene(p, progress, dir, {}, nullptr, group);
   Plan plan;  // the stages, with their times
   plan.stages = p.stages;
   const Scene& run = p.scene;
-  const ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
+  ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
   auto t0 = Clock::now();
   GeometryReport r = analyse(run, samples);
   r.timings_s.emplace_back("analysis", since(t0));
@@ -350,6 +352,7 @@ GeometryReport run_scene(const Plan& p, const Progress& progress, const std::fil
   plan.stage("impact").seconds = samples.seconds_impact;
   r.plan = std::move(plan.stages);
   r.scene_toml = to_toml(p.given);
+  if (keep) *keep = std::move(samples);
   return r;
 }
 
@@ -358,7 +361,7 @@ GeometryReport run_scene(const Scene& s, const Progress& progress, const std::fi
 }
 
 SceneOutput run_plan(const Plan& p, const Progress& progress, std::ostream* log, const std::filesystem::path& dir,
-                     Collective* group) {
+                     Collective* group, ContactSamples* keep) {
   const ThreadCountScope thread_scope(p.scene.ensemble.threads);  // for this call only (core/thread_count.hpp)
   // Without a directory from the caller the run stages its own files in out and renames them
   // into place at the end: a failure leaves out as it was (output_staging.hpp).
@@ -367,7 +370,7 @@ SceneOutput run_plan(const Plan& p, const Progress& progress, std::ostream* log,
   const std::filesystem::path& into = dir.empty() ? own->dir() : dir;
   SceneOutput o;
   switch (p.kind) {
-    case RunKind::sphere: o = run_sphere(p, progress, into, group); break;
+    case RunKind::sphere: o = run_sphere(p, progress, into, group, keep); break;
     case RunKind::radii: o = run_radii(p, progress, into); break;
     case RunKind::mesh: o = run_mesh(p, progress, into); break;
     case RunKind::bounce: o = run_bounce(p, progress, log, into); break;

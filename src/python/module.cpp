@@ -308,9 +308,11 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
   if (!files) scratch.emplace();
   {
     py::gil_scoped_release nogil;
-    out = run_plan(planned, p, nullptr, files ? std::filesystem::path() : scratch->path);
-    // The same drops again, bit-identical (every drop is a pure function of seed and index), kept.
-    if (arrays) samples = run_contact_ensemble(planned.scene.ensemble, p);
+    // The arrays are the run's own drops; a streaming run keeps none, so its arrays come from the
+    // same drops again, bit-identical (every drop is a pure function of seed and index).
+    out = run_plan(planned, p, nullptr, files ? std::filesystem::path() : scratch->path, nullptr,
+                   arrays && !planned.streams ? &samples : nullptr);
+    if (arrays && planned.streams) samples = run_contact_ensemble(planned.scene.ensemble, p);
   }
   py::dict report = py::module_::import("json").attr("loads")(out.json);
   if (arrays) report["arrays"] = samples_to_dict(std::move(samples));

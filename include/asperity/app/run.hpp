@@ -20,8 +20,10 @@ namespace asperity {
 /// carries the stages with their times and the scene as given, as TOML.
 /// `group` given (rank 0 of a run split across processes; p.control.share its share): a streaming
 /// run gathers the other processes' shares before the analysis (run_stream_share runs them).
+/// `keep` given: a run that keeps its drops (not p.streams) moves them there after its analysis
+/// (asperity.run's arrays: the run's own drops, not a second ensemble).
 GeometryReport run_scene(const Plan& p, const Progress& progress = {}, const std::filesystem::path& dir = {},
-                         Collective* group = nullptr);
+                         Collective* group = nullptr, ContactSamples* keep = nullptr);
 /// run_scene(plan(s)): for callers that hold a sphere scene (tests, benchmarks).
 GeometryReport run_scene(const Scene& s, const Progress& progress = {}, const std::filesystem::path& dir = {});
 
@@ -43,9 +45,10 @@ struct SceneOutput {
 /// `dir` given (validate-geometry: an OutputStaging's dir()): the files are written there under
 /// their final names and the caller commits them. `dir` empty: they are staged in the scene's out
 /// and renamed into place when the run succeeded; on an exception out is left as it was.
-/// `group`: as run_scene (only streaming sphere runs are split; others run on rank 0 alone).
+/// `group`, `keep`: as run_scene (only streaming sphere runs are split; others run on rank 0 alone).
 SceneOutput run_plan(const Plan& p, const Progress& progress = {}, std::ostream* log = nullptr,
-                     const std::filesystem::path& dir = {}, Collective* group = nullptr);
+                     const std::filesystem::path& dir = {}, Collective* group = nullptr,
+                     ContactSamples* keep = nullptr);
 
 /// run_plan(plan(s)): a scene of any kind, planned once (a run that does not fit in memory is
 /// refused before anything is allocated or written, resources.hpp).
