@@ -2,6 +2,7 @@
 #pragma once
 // A small streaming run and its checkpoints, in-process (test_checkpoint_trust, the checkpoint fuzz
 // target): no process is started, so a test can take many checkpoints and resume each.
+#include <filesystem>
 #include <functional>
 #include <vector>
 
@@ -26,10 +27,22 @@ inline Scene small_stream_scene() {
   return s;
 }
 
-/// Runs the planned stream of s; `each` sees the state at every wave boundary before the last
+/// The plan of `s` (as plan() makes it) for checkpoints in `out`, continuing them when `resume`:
+/// planned for an empty place and pointed at `out` afterwards, so that the tests can write and read
+/// checkpoints in a directory plan() itself would refuse for a new run.
+inline Plan checkpoint_plan(Scene s, const std::filesystem::path& out = {}, bool resume = false) {
+  const std::filesystem::path dir = out.empty() ? s.out : out;
+  s.out = std::filesystem::temp_directory_path() / "asperity-test-no-such-dir";
+  Plan p = plan(std::move(s));
+  p.given.out = p.scene.out = dir;
+  p.control.resume = resume;
+  return p;
+}
+
+/// Runs the planned stream of p; `each` sees the state at every wave boundary before the last
 /// (a checkpoint), and the run stops after `stop_after` of them (0: never). Returns the state at
 /// its end.
-inline StreamState run_stream(const Scene& s, const std::function<void(const StreamState&)>& each, int stop_after = 0,
+inline StreamState run_stream(const Plan& p, const std::function<void(const StreamState&)>& each, int stop_after = 0,
                               const StreamState* resume = nullptr) {
   int waves = 0;
   StreamHooks h;
@@ -38,7 +51,7 @@ inline StreamState run_stream(const Scene& s, const std::function<void(const Str
   h.checkpoint = [&](const StreamState& st) {
     if (each) each(st);
   };
-  return run_contact_stream(make_plan(s).scene.ensemble, {}, h, resume, s.share).state;
+  return run_contact_stream(p.scene.ensemble, {}, h, resume, p.control.share).state;
 }
 
 }  // namespace asperity::testing

@@ -110,8 +110,6 @@ std::string serialise(const std::string& key, const StreamState& st) {
   return out;
 }
 
-EnsembleConfig planned(const Scene& s) { return make_plan(s).scene.ensemble; }
-
 // What the user can do about a checkpoint this version cannot continue.
 std::string start_afresh(const fs::path& dir) {
   return "; to start afresh, remove " + (dir / kCheckpointScene).string() + " and the checkpoint*.bin files beside it";
@@ -161,7 +159,7 @@ std::vector<std::string> checkpoint_files(const fs::path& dir) {
 }
 
 // No state file for s.share: why, and what to do.
-[[noreturn]] void missing_state(const fs::path& dir, const Scene& s, const fs::path& path) {
+[[noreturn]] void missing_state(const fs::path& dir, const StreamShare& share, const fs::path& path) {
   std::string why = "--resume: no checkpoint " + path.string();
   const auto present = checkpoint_files(dir);
   const bool any_state = std::any_of(present.begin(), present.end(), [](const std::string& n) { return n != kCheckpointScene; });
@@ -169,9 +167,9 @@ std::vector<std::string> checkpoint_files(const fs::path& dir) {
     why += ": " + (dir / kCheckpointScene).string() +
            " is there without its state (a checkpoint cut off while being written, or by an older version): there is "
            "nothing to continue; remove it and run the scene again";
-  else if (s.share.ranks > 1 && fs::exists(dir / kCheckpointState))
+  else if (share.ranks > 1 && fs::exists(dir / kCheckpointState))
     why += " (" + (dir / kCheckpointState).string() + " was written by one process: resume it without mpirun)";
-  else if (s.share.ranks == 1)
+  else if (share.ranks == 1)
     why += " (a run split across P processes writes checkpoint.rank-R-of-P.bin: resume it with mpirun -np P)";
   throw std::invalid_argument(why);
 }
@@ -179,11 +177,11 @@ std::vector<std::string> checkpoint_files(const fs::path& dir) {
 // The file's bytes: a regular file (a link, FIFO or device is never opened or read) of exactly
 // `size` bytes, checked before reading. Another size: its magic line says whether it is of another
 // format (refused by name) or damaged.
-std::string read_state_file(const fs::path& path, std::size_t size, const Scene& s, const fs::path& dir) {
+std::string read_state_file(const fs::path& path, std::size_t size, const StreamShare& share, const fs::path& dir) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
     const int err = errno;
-    if (err == ENOENT) missing_state(dir, s, path);
+    if (err == ENOENT) missing_state(dir, share, path);
     if (err == ELOOP) throw std::invalid_argument(path.string() + ": a symbolic link; a checkpoint is read from a regular file only");
     throw std::invalid_argument("cannot read " + path.string() + ": " + std::generic_category().message(err));
   }
@@ -212,15 +210,15 @@ std::string read_state_file(const fs::path& path, std::size_t size, const Scene&
 
 }  // namespace
 
-std::string checkpoint_key(const Scene& s) {
-  Scene k = s;
+std::string checkpoint_key(const Plan& p) {
+  Scene k = p.given;
   k.ensemble.threads = 0;
   k.ensemble.kernel = Kernel::simd;  // the kernel changes no bit: --resume DIR --kernel scalar continues it
   k.plots = true;
   k.plot_format = "png";  // figures change no result
   k.out = "DIR";  // the directory may be named differently (relative, absolute) when resumed
   // The resolved design too: a version that resolves "auto" differently must not continue it.
-  const EnsembleConfig e = planned(s);
+  const EnsembleConfig& e = p.scene.ensemble;
   return to_toml(k) + "# planned: spheres = " + std::to_string(e.spheres) + ", backend = " + std::string(to_string(e.backend)) +
          ", bins_log2 = " + std::to_string(e.bins_log2) + "\n";
 }
@@ -237,11 +235,11 @@ bool is_checkpoint_name(std::string_view n) {
          n.substr(n.size() - bin.size()) == bin && n.find("-of-") != std::string_view::npos;
 }
 
-void write_checkpoint(const fs::path& dir, const Scene& s, const StreamState& st) {
+void write_checkpoint(const fs::path& dir, const Plan& p, const StreamState& st) {
   const AtomicDirectory d(dir);
   std::optional<AtomicDirectory::Staged> scene;
-  if (s.share.rank == 0) scene.emplace(d.stage(kCheckpointScene, to_toml(s)));
-  auto state = d.stage(checkpoint_state_name(s.share), stream_state_bytes(s, st));
+  if (p.control.share.rank == 0) scene.emplace(d.stage(kCheckpointScene, to_toml(p.given)));
+  auto state = d.stage(checkpoint_state_name(p.control.share), stream_state_bytes(p, st));
   // Both are complete on disk: only the renames are left. The scene first; if the state then
   // fails, a scene file this call created is removed again (a lone one would block both a new run
   // and --resume). A scene file that was there belongs to the previous state, which has the same
@@ -256,24 +254,24 @@ void write_checkpoint(const fs::path& dir, const Scene& s, const StreamState& st
   }
 }
 
-std::string stream_state_bytes(const Scene& s, const StreamState& st) { return serialise(checkpoint_key(s), st); }
+std::string stream_state_bytes(const Plan& p, const StreamState& st) { return serialise(checkpoint_key(p), st); }
 
 std::uint64_t checkpoint_checksum(std::string_view bytes) { return crc64(bytes.data(), bytes.size()); }
 
-std::size_t checkpoint_state_size(const Scene& s) {
-  const EnsembleConfig e = planned(s);
+std::size_t checkpoint_state_size(const Plan& p) {
+  const EnsembleConfig& e = p.scene.ensemble;
   const std::size_t G = std::min<std::uint64_t>(e.mode == Mode::sampled ? e.drops : e.spheres, kStreamBlocks);
   const std::size_t per_quantity = kStatHeader + 3 * sizeof(std::uint64_t) + (std::size_t{1} << e.bins_log2) * 8 +
                                    G * (std::size_t{1} << kStreamCoarseLog2) * 8 + G * sizeof(Moments);
-  return kMagic.size() + sizeof kByteOrderMark + 8 + checkpoint_key(s).size() + 6 * 8 + kStreamQuantities.size() * per_quantity + 8;
+  return kMagic.size() + sizeof kByteOrderMark + 8 + checkpoint_key(p).size() + 6 * 8 + kStreamQuantities.size() * per_quantity + 8;
 }
 
-StreamState read_checkpoint(const fs::path& dir, const Scene& s) {
-  const auto path = dir / checkpoint_state_name(s.share);
-  return stream_state_from_bytes(read_state_file(path, checkpoint_state_size(s), s, dir), s, path.string());
+StreamState read_checkpoint(const fs::path& dir, const Plan& p) {
+  const auto path = dir / checkpoint_state_name(p.control.share);
+  return stream_state_from_bytes(read_state_file(path, checkpoint_state_size(p), p.control.share, dir), p, path.string());
 }
 
-StreamState stream_state_from_bytes(const std::string& in, const Scene& s, const std::string& what) {
+StreamState stream_state_from_bytes(const std::string& in, const Plan& p, const std::string& what) {
   const fs::path dir = fs::path(what).parent_path();
   check_header(in, what, dir);
   Reader r{in, kMagic.size() + sizeof kByteOrderMark, in.size(), what};
@@ -283,26 +281,27 @@ StreamState stream_state_from_bytes(const std::string& in, const Scene& s, const
   std::memcpy(&stored, in.data() + r.end, 8);
   if (stored != crc64(in.data(), r.end))
     throw std::invalid_argument(what + ": damaged checkpoint (its checksum does not match its contents)" + start_afresh(dir));
-  if (r.text() != checkpoint_key(s))
+  if (r.text() != checkpoint_key(p))
     throw std::invalid_argument(what + ": written for another scene than " + kCheckpointScene +
                                 " with these options (only --threads, --quiet, --no-plots and --checkpoint-every may change)" +
                                 start_afresh(dir));
-  const EnsembleConfig e = planned(s);
+  const EnsembleConfig& e = p.scene.ensemble;
   StreamState st = initial_stream_state(e);
   st.next_unit = r.get<std::uint64_t>(), st.core_contacts = r.get<std::uint64_t>();
   st.check_queries = r.get<std::uint64_t>(), st.check_agreed = r.get<std::uint64_t>();
   st.index_bytes = r.get<std::uint64_t>();
   read_stats(r, st);
   if (r.at != r.end) throw std::invalid_argument(what + ": damaged checkpoint (trailing bytes)");
-  if (const std::string why = stream_state_problem(e, s.share, st); !why.empty())
+  if (const std::string why = stream_state_problem(e, p.control.share, st); !why.empty())
     throw std::invalid_argument(what + ": inconsistent checkpoint (" + why + ")" + start_afresh(dir));
   return st;
 }
 
-void check_checkpoint_files(const Scene& s) {
-  if (!uses_streaming(s.ensemble)) return;
-  if (s.resume) {
-    read_checkpoint(s.out, s);
+void check_checkpoint_files(const Plan& p) {
+  const Scene& s = p.given;
+  if (!p.streams) return;
+  if (p.control.resume) {
+    read_checkpoint(s.out, p);
     return;
   }
   const auto present = checkpoint_files(s.out);

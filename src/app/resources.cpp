@@ -123,19 +123,19 @@ double mesh_phases(const Scene& s, double run, std::ostringstream& d) {
 
 }  // namespace
 
-MemoryEstimate estimate_memory(const Scene& s) {
+MemoryEstimate estimate_memory(const Plan& p) {
+  const Scene& s = p.given;
   const auto& e = s.ensemble;
   const double N = double(e.sphere.asperities), n = double(e.drops);
   MemoryEstimate m;
   std::ostringstream d;
-  switch (run_kind(s)) {
+  switch (p.kind) {
     case RunKind::sphere: {
-      const Plan plan = make_plan(s);
-      const auto& pe = plan.scene.ensemble;
+      const auto& pe = p.scene.ensemble;
       double per_drop = pe.mode == Mode::sampled ? kPerDropFresh : kPerDropFixed;
       if (pe.impact.enabled) per_drop = kPerDropImpact;
       m.bytes = kBaseSphere + per_drop * n;
-      if (uses_streaming(pe)) {
+      if (p.streams) {
         // Streaming keeps no drop: 3 quantities x (a fine histogram per thread + the merged one +
         // the per-block cells) x 8 B (experiments/streaming.hpp).
         const double fine = std::ldexp(1.0, int(pe.bins_log2)), cells = double(kStreamBlocks << kStreamCoarseLog2);
@@ -254,12 +254,6 @@ double memory_limit_bytes() {
   return limit;
 }
 
-void check_run(const Scene& s) {
-  validate(s);                // the estimate needs a valid scene (counts >= 1)
-  check_memory(s);            // before read_mesh allocates: a mesh's size comes from its header
-  check_scene_inputs(s);
-}
-
 namespace {
 
 // What a user can lower, by the kind of run: the scene keys with their options.
@@ -300,10 +294,11 @@ void check_bytes(double bytes, const std::string& what, const std::string& lower
                         " this process may use: lower " + lower);
 }
 
-void check_memory(const Scene& s) {
+void check_memory(const Plan& p) {
+  const Scene& s = p.given;
   const double limit = memory_limit_bytes();
   if (!(limit > 0)) return;  // unknown: let the allocation decide
-  const MemoryEstimate m = estimate_memory(s);
+  const MemoryEstimate m = estimate_memory(p);
   if (m.bytes > limit)
     throw MemoryRefused("this run needs about " + gb(m.bytes) + " of memory (" + m.detail + "), more than the " +
                                 gb(limit) + " this process may use: lower " + lower_hint(s));

@@ -149,7 +149,8 @@ void export_first_body(const Scene& s, const TriangleMesh& mesh, const std::file
             -mass_properties(mesh, sb.density).centroid);
 }
 
-SceneOutput run_radii(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
+SceneOutput run_radii(const Plan& p, const Progress& progress, const std::filesystem::path& dir) {
+  const Scene& s = p.scene;
   RadiiReport r = run_radii_experiment(radii_experiment(s), progress);
   if (s.plots) {
     const auto t0 = Clock::now();
@@ -178,9 +179,10 @@ SceneOutput run_radii(const Scene& s, const Progress& progress, const std::files
   return o;
 }
 
-SceneOutput run_mesh(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
+SceneOutput run_mesh(const Plan& p, const Progress& progress, const std::filesystem::path& dir) {
+  const Scene& s = p.scene;
   const MeshImpactExperiment m = mesh_experiment(s);
-  const TriangleMesh mesh = read_mesh(m.mesh, m.scale);
+  const TriangleMesh& mesh = *p.mesh;  // read once, by plan()
   SceneOutput o;
   double seconds_export = 0;
   if (!s.mesh->export_ply.empty()) {
@@ -212,7 +214,8 @@ SceneOutput run_mesh(const Scene& s, const Progress& progress, const std::filesy
   return o;
 }
 
-SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* log, const std::filesystem::path& dir) {
+SceneOutput run_bounce(const Plan& p, const Progress& progress, std::ostream* log, const std::filesystem::path& dir) {
+  const Scene& s = p.scene;
   const auto& e = s.ensemble;
   SceneOutput o;
   auto t0 = Clock::now();
@@ -246,10 +249,10 @@ SceneOutput run_bounce(const Scene& s, const Progress& progress, std::ostream* l
   return o;
 }
 
-SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
+SceneOutput run_mesh_bounce(const Plan& p, const Progress& progress, const std::filesystem::path& dir) {
+  const Scene& s = p.scene;
   const MeshBounceExperiment m = mesh_bounce_experiment(s);
-  const std::optional<TriangleMesh> mesh =
-      m.mesh.empty() ? std::nullopt : std::optional<TriangleMesh>(read_mesh(m.mesh, m.scale));
+  const TriangleMesh* mesh = p.mesh.get();  // read once, by plan()
   SceneOutput o;
   double seconds_export = 0;
   if (!s.mesh->export_ply.empty()) {
@@ -258,7 +261,7 @@ SceneOutput run_mesh_bounce(const Scene& s, const Progress& progress, const std:
     export_first_body(s, *mesh, dir);
     seconds_export = since(t0);
   }
-  MeshBounceReport r = run_mesh_bounces(m, mesh ? &*mesh : nullptr, progress);
+  MeshBounceReport r = run_mesh_bounces(m, mesh, progress);
   if (s.plots) {
     const auto t0 = Clock::now();
     r.plots = write_mesh_bounce_plots(dir, r, parse_plot_formats(s.plot_format));
@@ -303,8 +306,10 @@ void write_scene_cor_table(const Scene& s, const Progress& progress, const std::
   o.table += line.str();
 }
 
-SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::filesystem::path& dir, Collective* group) {
-  const GeometryReport r = run_scene(s, progress, dir, group);
+SceneOutput run_sphere(const Plan& p, const Progress& progress, const std::filesystem::path& dir, Collective* group,
+                       ContactSamples* keep) {
+  const Scene& s = p.given;
+  const GeometryReport r = run_scene(p, progress, dir, group, keep);
   SceneOutput o;
   o.files = r.plots;
   o.rejected = r.rejected();
@@ -323,12 +328,13 @@ SceneOutput run_sphere(const Scene& s, const Progress& progress, const std::file
 
 }  // namespace
 
-GeometryReport run_scene(const Scene& s, const Progress& progress, const std::filesystem::path& dir, Collective* group) {
-  validate(s);
-  Plan plan = make_plan(s);
-  if (uses_streaming(plan.scene.ensemble)) return run_stream_scene(std::move(plan), s, progress, dir, {}, nullptr, group);
-  const Scene& run = plan.scene;
-  const ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
+GeometryReport run_scene(const Plan& p, const Progress& progress, const std::filesystem::path& dir, Collective* group,
+                         ContactSamples* keep) {
+  if (p.streams) return run_stream_scene(p, progress, dir, {}, nullptr, group);
+  Plan plan;  // the stages, with their times
+  plan.stages = p.stages;
+  const Scene& run = p.scene;
+  ContactSamples samples = run_contact_ensemble(run.ensemble, progress);
   auto t0 = Clock::now();
   GeometryReport r = analyse(run, samples);
   r.timings_s.emplace_back("analysis", since(t0));
@@ -345,150 +351,41 @@ GeometryReport run_scene(const Scene& s, const Progress& progress, const std::fi
   if (plan.runs("cross_check")) plan.stage("cross_check").seconds = samples.cross_check.seconds;
   plan.stage("impact").seconds = samples.seconds_impact;
   r.plan = std::move(plan.stages);
-  r.scene_toml = to_toml(s);
+  r.scene_toml = to_toml(p.given);
+  if (keep) *keep = std::move(samples);
   return r;
 }
 
-namespace {
-
-// The largest asperity radius a scene can draw (levels: the largest; lognormal: the median).
-double top_radius(const Scene& s) {
-  if (!s.radii) return s.ensemble.sphere.asperity_radius;
-  const auto& d = s.radii->radii;
-  switch (d.kind) {
-    case RadiusDistribution::Kind::levels: return *std::max_element(d.levels.begin(), d.levels.end());
-    case RadiusDistribution::Kind::lognormal: return d.median;
-    case RadiusDistribution::Kind::fixed: return d.radius;
-  }
-  return d.radius;
+GeometryReport run_scene(const Scene& s, const Progress& progress, const std::filesystem::path& dir) {
+  return run_scene(plan(s), progress, dir);
 }
 
-std::string show(double v) {
-  std::ostringstream os;
-  os << v;
-  return os.str();
-}
-
-}  // namespace
-
-void check_scene_inputs(const Scene& s) {
-  validate(s);
-  if (s.resume && !uses_streaming(s.ensemble))
-    throw std::invalid_argument("--resume: the scene of " + s.out.string() + " does not stream (statistics = raw)");
-  // A checkpoint in the output directory belongs to an interrupted streaming run: never
-  // overwritten; a resumed run's is read whole now, before any file is touched.
-  check_checkpoint_files(s);
-  if (!s.mesh) return;
-  const auto& m = *s.mesh;
-  TriangleMesh mesh;
-  try {
-    mesh = read_mesh(m.file, m.scale);
-  } catch (const std::exception& ex) {
-    throw std::invalid_argument("body.mesh: " + std::string(ex.what()));
-  }
-  if (mesh.vertices.empty() || mesh.faces.empty())
-    throw std::invalid_argument("body.mesh: " + m.file.string() + " has no triangles");
-  const double density = s.ensemble.impact.density;
-  MassProperties mp;
-  try {
-    mp = mass_properties(mesh, density);
-  } catch (const std::exception& ex) {
-    throw std::invalid_argument("body.mesh: " + m.file.string() + " x body.scale = " + show(m.scale) + ": " + ex.what());
-  }
-  // The body's size: its bounding radius about the centre of mass and its half-extents along
-  // the mesh axes (where asperity centres and the smooth surface live).
-  double L = 0;
-  Vec3 half = Vec3::Zero();
-  for (const auto& v : mesh.vertices) {
-    L = std::max(L, (v - mp.centroid).norm());
-    half = half.cwiseMax(v.cwiseAbs());
-  }
-  const double thinnest = half.minCoeff();
-  const std::string size = "the body (" + m.file.filename().string() + " x body.scale = " + show(m.scale) +
-                           ") has a bounding radius of " + show(L) + " m";
-  if (!(std::isfinite(L) && L <= kMaxLength))
-    throw std::invalid_argument("body.scale: " + size + "; supported: <= " + show(kMaxLength) + " m");
-  const Eigen::Vector3d moments = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(mp.inertia).eigenvalues();
-  if (!std::isnormal(mp.mass) || !(moments.minCoeff() > 0) || !std::isnormal(moments.minCoeff()) ||
-      !std::isfinite(moments.maxCoeff()))
-    throw std::invalid_argument("body.scale: " + size + " and material.density = " + show(density) +
-                                " kg/m^3 give a mass or moment of inertia outside the range of double");
-  const double a = top_radius(s);
-  if (!(a < thinnest))
-    throw std::invalid_argument("asperities.radius: " + show(a) + " m must be smaller than the body's smallest half-extent " +
-                                show(thinnest) + " m (body.mesh x body.scale)");
-  if (!m.smooth.empty()) {
-    const char* axis = "xyz";
-    for (int i = 0; i < 3; ++i) {
-      const double ax = m.smooth[static_cast<std::size_t>(i)];
-      if (!(ax >= 0.5 * half[i] && ax <= 2.0 * half[i]))
-        throw std::invalid_argument("body.smooth: semi-axis " + std::string(1, axis[i]) + " = " + show(ax) +
-                                    " m must match the mesh (its half-extent along " + std::string(1, axis[i]) + " is " +
-                                    show(half[i]) + " m; supported: 0.5x to 2x)");
-    }
-    if (m.smooth.size() == 4 && !(m.smooth[3] >= 2 && m.smooth[3] <= kMaxSuperellipsoidExponent))
-      throw std::invalid_argument("body.smooth: exponent m = " + show(m.smooth[3]) + " must be in [2, " +
-                                  show(kMaxSuperellipsoidExponent) + "]");
-  }
-  // Spin: one rule for every body, as for the sphere (ensemble.hpp): the surface speed
-  // |Omega| x bounding radius within the supported range.
-  const Vec3 omega = s.bounce.enabled ? s.bounce.omega : s.ensemble.impact.omega;
-  const std::string key = "experiment.Omega (--omega-x/--omega-y)";
-  const double surface = omega.stableNorm() * L;
-  const double max_surface = s.bounce.enabled ? kMaxBounceSpeed : kMaxSpeed;  // a bounce: Eq. 9's range (bounce.hpp)
-  if (!(surface <= max_surface))
-    throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
-                                " m (the body's bounding radius) gives a surface speed of " + show(surface) +
-                                " m/s; must be <= " + show(max_surface) + " m/s (supported range)");
-  if (!s.bounce.enabled && !(surface < s.ensemble.impact.speed))
-    throw std::invalid_argument(key + ": |Omega| = " + show(omega.stableNorm()) + " rad/s x " + show(L) +
-                                " m (the body's bounding radius; body.scale = " + show(m.scale) +
-                                ") gives a surface speed of " + show(surface) + " m/s, not below the approach speed " +
-                                show(s.ensemble.impact.speed) +
-                                " m/s: parts of the body would recede from the plate (supported: |Omega| L < |V.z|)");
-}
-
-RunKind run_kind(const Scene& s) {
-  if (s.bounce.enabled) return s.mesh ? RunKind::mesh_bounce : RunKind::bounce;
-  if (s.mesh) return RunKind::mesh;
-  if (s.radii) return RunKind::radii;
-  return RunKind::sphere;
-}
-
-std::string_view to_string(RunKind k) {
-  switch (k) {
-    case RunKind::sphere: return "sphere";
-    case RunKind::radii: return "radii";
-    case RunKind::mesh: return "mesh";
-    case RunKind::bounce: return "bounce";
-    case RunKind::mesh_bounce: return "mesh-bounce";
-  }
-  return "?";
-}
-
-SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log,
-                             const std::filesystem::path& dir, Collective* group) {
-  check_run(s);  // validate(s), the memory estimate, a mesh body's derived quantities: before any file is written
-  const ThreadCountScope thread_scope(s.ensemble.threads);  // for this call only (core/thread_count.hpp)
-  // Without a directory from the caller the run stages its own files in s.out and renames them
-  // into place at the end: a failure leaves s.out as it was (output_staging.hpp).
+SceneOutput run_plan(const Plan& p, const Progress& progress, std::ostream* log, const std::filesystem::path& dir,
+                     Collective* group, ContactSamples* keep) {
+  const ThreadCountScope thread_scope(p.scene.ensemble.threads);  // for this call only (core/thread_count.hpp)
+  // Without a directory from the caller the run stages its own files in out and renames them
+  // into place at the end: a failure leaves out as it was (output_staging.hpp).
   std::optional<OutputStaging> own;
-  if (dir.empty()) own.emplace(s.out);
+  if (dir.empty()) own.emplace(p.scene.out);
   const std::filesystem::path& into = dir.empty() ? own->dir() : dir;
   SceneOutput o;
-  switch (run_kind(s)) {
-    case RunKind::sphere: o = run_sphere(s, progress, into, group); break;
-    case RunKind::radii: o = run_radii(s, progress, into); break;
-    case RunKind::mesh: o = run_mesh(s, progress, into); break;
-    case RunKind::bounce: o = run_bounce(s, progress, log, into); break;
-    case RunKind::mesh_bounce: o = run_mesh_bounce(s, progress, into); break;
+  switch (p.kind) {
+    case RunKind::sphere: o = run_sphere(p, progress, into, group, keep); break;
+    case RunKind::radii: o = run_radii(p, progress, into); break;
+    case RunKind::mesh: o = run_mesh(p, progress, into); break;
+    case RunKind::bounce: o = run_bounce(p, progress, log, into); break;
+    case RunKind::mesh_bounce: o = run_mesh_bounce(p, progress, into); break;
   }
-  o.kind = run_kind(s);
+  o.kind = p.kind;
   if (own) {
     for (const auto& f : o.files) own->add(f);
     own->commit();
   }
   return o;
+}
+
+SceneOutput run_scene_output(const Scene& s, const Progress& progress, std::ostream* log, const std::filesystem::path& dir) {
+  return run_plan(plan(s), progress, log, dir);
 }
 
 }  // namespace asperity

@@ -207,7 +207,7 @@ void validate_radii_run(const Scene& s) {
 
 void validate(const Scene& s) {
   if (s.mesh) {
-    // A mesh body's size is its mesh x scale (check_scene_inputs, run.hpp, checks the asperity
+    // A mesh body's size is its mesh x scale (plan(), plan.hpp, checks the asperity
     // radius against it): the sphere radius is unused and must not refuse the asperity radius.
     EnsembleConfig e = s.ensemble;
     e.sphere.radius = std::max(e.sphere.radius, 2.0 * e.sphere.asperity_radius);

@@ -355,7 +355,7 @@ std::vector<double> read_smooth(Reader& body, std::vector<double> sm) {
     body.bad("smooth", "expected [a, b, c] or [a, b, c, m] [m], got " + std::to_string(sm.size()) + " numbers");
   for (std::size_t i = 0; i < sm.size(); ++i)
     if (!(sm[i] > 0)) body.bad("smooth", "element " + std::to_string(i) + " must be > 0, got " + num(sm[i]));
-  // The supported lengths (geometry.hpp); check_scene_inputs (run.hpp) also matches them to the mesh.
+  // The supported lengths (geometry.hpp); plan() (plan.hpp) also matches them to the mesh.
   for (std::size_t i = 0; i < 3; ++i)
     if (!(sm[i] >= kMinLength && sm[i] <= kMaxLength))
       body.bad("smooth", "semi-axis " + std::to_string(i) + " must be in [" + num(kMinLength) + ", " +

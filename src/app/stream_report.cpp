@@ -268,24 +268,26 @@ void gather_shares(ContactStream& cs, Collective& group) {
   cs.cross_check.queries = st.check_queries, cs.cross_check.agreed = st.check_agreed;
 }
 
-// The stream of `run` (the planned ensemble of scene s), or of this process's share s.share, with
-// checkpoints in s.out (not the staging directory: a checkpoint outlives an interrupted run): every
-// s.checkpoint_seconds, and when a signal arrives (validate-geometry: the signal waits for the end
+// The stream of the planned ensemble, or of this process's share (p.control.share), with
+// checkpoints in the scene's out (not the staging directory: a checkpoint outlives an interrupted
+// run): every p.control.checkpoint_seconds, and when a signal arrives (validate-geometry: the signal waits for the end
 // of a wave, the checkpoint is written, then the signal ends the process as usual, exit 128 +
 // signal). With a group, every process learns whether all completed (a process that completed
 // while another stopped writes its finished share too, so that the resume skips it), and the
 // shares are gathered at rank 0, which returns the merged stream.
-ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run, const Progress& progress,
+ContactStream stream_with_checkpoints(const Plan& p, const Progress& progress,
                                       const StreamHooks& given, const StreamState* resume, Collective* group) {
+  const Scene& s = p.given;
+  const RunControl& c = p.control;
   StreamHooks h = given;
   using Clock = std::chrono::steady_clock;
   auto last = Clock::now();
   if (!h.stop) h.stop = [] { return interrupt_pending() != 0; };
-  if (!h.checkpoint_due && s.checkpoint_seconds > 0)
-    h.checkpoint_due = [&] { return std::chrono::duration<double>(Clock::now() - last).count() >= s.checkpoint_seconds; };
+  if (!h.checkpoint_due && c.checkpoint_seconds > 0)
+    h.checkpoint_due = [&] { return std::chrono::duration<double>(Clock::now() - last).count() >= c.checkpoint_seconds; };
   if (!h.checkpoint)
     h.checkpoint = [&](const StreamState& st) {
-      write_checkpoint(s.out, s, st);
+      write_checkpoint(s.out, p, st);
       last = Clock::now();
     };
   std::optional<InterruptDeferral> defer;
@@ -296,8 +298,8 @@ ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run,
   ContactStream cs;
   try {
     StreamState resumed;
-    if (!resume && s.resume) resumed = read_checkpoint(s.out, s), resume = &resumed;
-    cs = run_contact_stream(run, progress, h, resume, s.share);
+    if (!resume && c.resume) resumed = read_checkpoint(s.out, p), resume = &resumed;
+    cs = run_contact_stream(p.scene.ensemble, progress, h, resume, c.share);
     status = cs.complete ? 0 : 1;
   } catch (const std::exception& ex) {
     if (!group) throw;
@@ -310,11 +312,11 @@ ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run,
   }
   if (status == 1) {
     if (cs.complete) h.checkpoint(cs.state);
-    const std::string where = (s.out / checkpoint_state_name(s.share)).string();
-    if (s.share.rank == 0)
-      std::cerr << "\nvalidate-geometry: stopped after " << cs.state.stats[0].n() << " of " << share_drops(run, s.share)
-                << " drops" << (s.share.ranks > 1 ? " of rank 0's share" : "") << "; checkpoint in " << where
-                << ": continue with " << (s.share.ranks > 1 ? "mpirun -np " + std::to_string(s.share.ranks) + " " : "")
+    const std::string where = (s.out / checkpoint_state_name(c.share)).string();
+    if (c.share.rank == 0)
+      std::cerr << "\nvalidate-geometry: stopped after " << cs.state.stats[0].n() << " of " << share_drops(p.scene.ensemble, c.share)
+                << " drops" << (c.share.ranks > 1 ? " of rank 0's share" : "") << "; checkpoint in " << where
+                << ": continue with " << (c.share.ranks > 1 ? "mpirun -np " + std::to_string(c.share.ranks) + " " : "")
                 << "validate-geometry --resume " << s.out.string() << "\n";
     defer.reset();  // a pending signal ends the process here
     throw StreamEnded("the streaming run stopped before its last drop; checkpoint in " + where);
@@ -324,10 +326,12 @@ ContactStream stream_with_checkpoints(const Scene& s, const EnsembleConfig& run,
 }
 }  // namespace
 
-GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
+GeometryReport run_stream_scene(const Plan& p, const Progress& progress, const std::filesystem::path& dir,
                                 const StreamHooks& hooks, const StreamState* resume, Collective* group) {
-  const Scene& run = plan.scene;
-  const ContactStream cs = stream_with_checkpoints(s, run.ensemble, progress, hooks, resume, group);
+  const Scene& run = p.scene;
+  Plan plan;  // the stages, with their times
+  plan.stages = p.stages;
+  const ContactStream cs = stream_with_checkpoints(p, progress, hooks, resume, group);
   auto t0 = std::chrono::steady_clock::now();
   auto since = [](auto t) { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count(); };
   GeometryReport r = analyse_stream(run, cs);
@@ -350,13 +354,10 @@ GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progr
   plan.stage("index").seconds = cs.seconds_index;
   plan.stage("query").seconds = cs.seconds_query;
   r.plan = std::move(plan.stages);
-  r.scene_toml = to_toml(s);
+  r.scene_toml = to_toml(p.given);
   return r;
 }
 
-void run_stream_share(const Scene& s, Collective& group) {
-  const Plan plan = make_plan(s);
-  stream_with_checkpoints(s, plan.scene.ensemble, {}, {}, nullptr, &group);
-}
+void run_stream_share(const Plan& p, Collective& group) { stream_with_checkpoints(p, {}, {}, nullptr, &group); }
 
 }  // namespace asperity

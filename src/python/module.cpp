@@ -353,13 +353,13 @@ struct PrivateDir {
 // checkpoints -- and refuses a scene whose outputs are files (a notebook must not litter its working
 // directory); a path writes the scene's outputs there; True writes them to the scene's outputs.dir.
 // Returns whether files are written.
-bool apply_out(Scene& scene, const py::object& out) {
+bool apply_out(Scene& scene, RunControl& control, const py::object& out) {
   if (out.is_none() || (py::isinstance<py::bool_>(out) && !out.cast<bool>())) {
     const char* file_output = scene.cor_table ? "outputs.cor_table" : scene.mesh && !scene.mesh->export_ply.empty() ? "body.export_ply" : nullptr;
     if (file_output)
       value_error(std::string("out: the scene's ") + file_output + " writes a file; pass out=DIR (or out=True for the scene's outputs.dir)");
     scene.plots = false;
-    scene.checkpoint_seconds = 0;  // no signal handler in Python: never written
+    control.checkpoint_seconds = 0;  // no signal handler in Python: never written
     return false;
   }
   if (py::isinstance<py::bool_>(out)) return true;  // True: the scene's outputs.dir
@@ -373,7 +373,8 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
                const py::object& out_arg) {
   check_callable(progress);
   Scene scene = to_scene(scene_arg);
-  const bool files = apply_out(scene, out_arg);
+  RunControl control;
+  const bool files = apply_out(scene, control, out_arg);
   bool arrays = false;
   if (arrays_arg.is_none())
     arrays = run_kind(scene) == RunKind::sphere && scene.ensemble.drops <= max_array_drops;
@@ -384,9 +385,11 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
       value_error("arrays: per-drop arrays exist for sphere scenes only, not for a " + std::string(to_string(run_kind(scene))) + " scene");
     arrays = true;
   }
+  const Plan planned = plan(std::move(scene), control);  // the run's one plan
   if (arrays) {  // the arrays' pass keeps every drop: its estimate is the raw run's
-    Scene raw = scene;
-    raw.ensemble.statistics = Statistics::raw;
+    Plan raw = planned;
+    raw.scene.ensemble.statistics = raw.given.ensemble.statistics = Statistics::raw;
+    raw.streams = false;
     check_memory(raw);
   }
   const Progress p = python_progress(progress);
@@ -396,9 +399,11 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
   if (!files) scratch.emplace();
   {
     py::gil_scoped_release nogil;
-    out = run_scene_output(scene, p, nullptr, files ? std::filesystem::path() : scratch->path);
-    // The same drops again, bit-identical (every drop is a pure function of seed and index), kept.
-    if (arrays) samples = run_contact_ensemble(make_plan(scene).scene.ensemble, p);
+    // The arrays are the run's own drops; a streaming run keeps none, so its arrays come from the
+    // same drops again, bit-identical (every drop is a pure function of seed and index).
+    out = run_plan(planned, p, nullptr, files ? std::filesystem::path() : scratch->path, nullptr,
+                   arrays && !planned.streams ? &samples : nullptr);
+    if (arrays && planned.streams) samples = run_contact_ensemble(planned.scene.ensemble, p);
   }
   py::dict report = py::module_::import("json").attr("loads")(out.json);
   if (arrays) report["arrays"] = samples_to_dict(std::move(samples));

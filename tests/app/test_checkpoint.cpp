@@ -116,6 +116,46 @@ TEST(Checkpoint, ANonAsciiOutputDirectoryResumes) {
   fs::remove(log);
 }
 
+// Issue 35: an impact scene whose restitution output is off streams (the plan switches the impacts
+// off, and statistics "auto" streams above 2^25 drops without impacts). Three checks used to read
+// the scene as written and took it for a raw run: the completed run left its checkpoint files beside
+// the report, --resume on them exited 2 ("does not stream"), and a new run would have written over
+// an interrupted one's. The plan alone answers now (plan.hpp). Exactly the scene of the issue:
+// sphere, experiment.kind = "impact", outputs.restitution = false, mode = "sampled", N = 1000,
+// 4e7 drops, --checkpoint-every 2.
+TEST(Checkpoint, AnImpactSceneWithoutRestitutionStreamsCompletesAndResumes) {
+  const fs::path cut = fresh_dir("impact");
+  const fs::path scene = cut.string() + ".toml", log = cut.string() + ".log";
+  std::ofstream(scene) << "format = 1\nname = \"issue35\"\n[body]\nkind = \"sphere\"\nradius = 3e-3\n"
+                          "[material]\ndensity = 7850.0\neps_t = 1.0\nrestitution = { model = \"viscoelastic\", beta = 0.0467 }\n"
+                          "[asperities]\ncount = 1000\nradius = { distribution = \"fixed\", value = 6.5e-7 }\n"
+                          "[ensemble]\nmode = \"sampled\"\ndrops = 40000000\nseed = 1\n"
+                          "[experiment]\nkind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]\n"
+                          "[outputs]\nrestitution = false\nplots = false\n";
+  // Stopped after its first checkpoint (one run of the whole scene costs ~35 s of CPU; the resumed
+  // run below completes it, and the whole run's bits are SigtermThenResumeEqualsTheUninterruptedRun's).
+  const pid_t pid = spawn({"-q", "--scene", scene.string(), "--checkpoint-every", "2", "--out", cut.string()}, log);
+  for (int i = 0; i < 20000 && !fs::exists(cut / "checkpoint.bin"); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  ASSERT_TRUE(fs::exists(cut / "checkpoint.bin")) << "no checkpoint: the run was taken for a raw one? " << slurp(log);
+  ::kill(pid, SIGTERM);
+  ASSERT_EQ(wait_status(pid), 128 + SIGTERM) << "the run ended before the signal? " << slurp(log);
+  // A new run into that directory is refused: the checkpoint is not its own to overwrite.
+  auto r = run_command(vg() + " -q --scene " + scene.string() + " --out " + cut.string() + " 2>&1");
+  EXPECT_EQ(r.status, 2) << r.out;
+  EXPECT_NE(r.out.find("--resume"), std::string::npos) << r.out;
+  // --resume continues it (before: exit 2, "does not stream"), and the completed run removes the
+  // checkpoint (before: checkpoint.bin and checkpoint.toml were left beside the report).
+  r = run_command(vg() + " -q --resume " + cut.string() + " --checkpoint-every 2 2>&1");
+  EXPECT_TRUE(r.status == 0 || r.status == 1) << r.out;
+  EXPECT_FALSE(fs::exists(cut / "checkpoint.bin") || fs::exists(cut / "checkpoint.toml"))
+      << "a completed run leaves no checkpoint";
+  const auto report = nlohmann::json::parse(slurp(cut / "report.json"));
+  EXPECT_EQ(report.at("statistics").get<std::string>().rfind("streaming", 0), 0u) << report.at("statistics");
+  EXPECT_EQ(report.at("parameters").at("drops").get<std::uint64_t>(), 40'000'000u);
+  fs::remove_all(cut), fs::remove(scene), fs::remove(log);
+}
+
 TEST(Checkpoint, DamagedOrForeignCheckpointsAreRefused) {
   const fs::path dir = fresh_dir("damaged");
   fs::create_directories(dir);

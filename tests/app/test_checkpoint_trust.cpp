@@ -29,6 +29,7 @@
 
 namespace fs = std::filesystem;
 using namespace asperity;
+using asperity::testing::checkpoint_plan;
 using asperity::testing::run_stream;
 using asperity::testing::slurp;
 using asperity::testing::small_stream_scene;
@@ -53,10 +54,10 @@ std::string refusal(F&& f) {
 }
 
 // As --resume takes it: the scene from checkpoint.toml, the directory, another thread count.
-Scene resumed_scene(const fs::path& dir, int threads) {
+Plan resumed_plan(const fs::path& dir, int threads) {
   Scene r = load_scene(dir / kCheckpointScene);
-  r.out = dir, r.resume = true, r.ensemble.threads = threads;
-  return r;
+  r.ensemble.threads = threads;
+  return checkpoint_plan(std::move(r), dir, true);
 }
 
 // A checkpoint written after every wave of a run with one thread (each into its own directory),
@@ -65,15 +66,16 @@ void expect_every_resume_bit_identical(Scene s, const std::string& name) {
   const fs::path root = fresh_dir(name);
   std::vector<fs::path> dirs;
   s.ensemble.threads = 1;
-  const StreamState whole = run_stream(s, [&](const StreamState& st) {
+  Plan p = checkpoint_plan(s);
+  const StreamState whole = run_stream(p, [&](const StreamState& st) {
     dirs.push_back(root / std::to_string(dirs.size()));
     fs::create_directory(dirs.back());
-    s.out = dirs.back();
-    write_checkpoint(dirs.back(), s, st);
+    p.given.out = p.scene.out = dirs.back();
+    write_checkpoint(dirs.back(), p, st);
   });
   ASSERT_GE(dirs.size(), 2u) << "too few waves to cut the run";
   for (const fs::path& d : {dirs.front(), dirs[dirs.size() / 2], dirs.back()}) {
-    const Scene r = resumed_scene(d, 2);
+    const Plan r = resumed_plan(d, 2);
     const StreamState st = read_checkpoint(d, r);
     EXPECT_LT(st.next_unit, whole.next_unit);
     EXPECT_EQ(run_stream(r, {}, 0, &st), whole) << name << ": resumed from " << d;
@@ -104,7 +106,7 @@ TEST(CheckpointTrust, EveryStreamingRunResumesToTheSameBits) {
 }
 
 TEST(CheckpointTrust, EverySingleByteFlipIsRefused) {
-  const Scene s = small_stream_scene();
+  const Plan s = checkpoint_plan(small_stream_scene());
   StreamState cut;
   run_stream(s, [&](const StreamState& st) { cut = st; }, 1);
   const std::string good = stream_state_bytes(s, cut);
@@ -126,11 +128,11 @@ TEST(CheckpointTrust, EverySingleByteFlipIsRefused) {
 }
 
 TEST(CheckpointTrust, InconsistentCountsAreRefusedEvenWithAValidChecksum) {
-  const Scene s = small_stream_scene();
+  const Plan s = checkpoint_plan(small_stream_scene());
   StreamState cut;
   run_stream(s, [&](const StreamState& st) { cut = st; }, 1);
-  const EnsembleConfig e = make_plan(s).scene.ensemble;
-  ASSERT_EQ(stream_state_problem(e, s.share, cut), "");
+  const EnsembleConfig e = s.scene.ensemble;
+  ASSERT_EQ(stream_state_problem(e, s.control.share, cut), "");
   const std::vector<std::pair<std::string, std::function<void(StreamState&)>>> faults{
       {"fine histogram", [](StreamState& t) { ++t.stats[1].fine[7]; }},
       {"block 0", [](StreamState& t) { ++t.stats[0].coarse[3]; }},
@@ -150,8 +152,8 @@ TEST(CheckpointTrust, InconsistentCountsAreRefusedEvenWithAValidChecksum) {
   for (const auto& [what, fault] : faults) {
     StreamState bad = cut;
     fault(bad);
-    EXPECT_NE(stream_state_problem(e, s.share, bad).find(what), std::string::npos)
-        << what << ": " << stream_state_problem(e, s.share, bad);
+    EXPECT_NE(stream_state_problem(e, s.control.share, bad).find(what), std::string::npos)
+        << what << ": " << stream_state_problem(e, s.control.share, bad);
     // Written with a valid checksum, as a careless tool might: still refused, naming the file.
     const std::string why = refusal([&] { stream_state_from_bytes(stream_state_bytes(s, bad), s, "d/checkpoint.bin"); });
     EXPECT_NE(why.find("d/checkpoint.bin: inconsistent checkpoint"), std::string::npos) << why;
@@ -160,8 +162,7 @@ TEST(CheckpointTrust, InconsistentCountsAreRefusedEvenWithAValidChecksum) {
 
 TEST(CheckpointTrust, OnlyARegularFileOfTheRightSizeAndSceneIsRead) {
   const fs::path dir = fresh_dir("files");
-  Scene s = small_stream_scene();
-  s.out = dir, s.resume = true;
+  const Plan s = checkpoint_plan(small_stream_scene(), dir, true);
   StreamState cut;
   run_stream(s, [&](const StreamState& st) { cut = st; }, 1);
   write_checkpoint(dir, s, cut);
@@ -191,8 +192,9 @@ TEST(CheckpointTrust, OnlyARegularFileOfTheRightSizeAndSceneIsRead) {
   fs::remove(bin), fs::create_directory(bin), refused("not a regular file");
   // A state of another scene beside this checkpoint.toml (a mismatched pair).
   fs::remove(bin);
-  Scene other = s;
-  other.ensemble.seed += 1;
+  Scene o = small_stream_scene();
+  o.ensemble.seed += 1;
+  const Plan other = checkpoint_plan(o, dir, true);
   put(stream_state_bytes(other, cut)), refused("another scene");
   put(good);
   EXPECT_EQ(read_checkpoint(dir, s), cut) << "the good file again: accepted";
@@ -201,8 +203,7 @@ TEST(CheckpointTrust, OnlyARegularFileOfTheRightSizeAndSceneIsRead) {
 
 TEST(CheckpointTrust, LinksPlantedAtEveryTemporaryAndFinalNameAreNeverFollowed) {
   const fs::path dir = fresh_dir("links"), outside = fresh_dir("links-outside");
-  Scene s = small_stream_scene();
-  s.out = dir;
+  Plan s = checkpoint_plan(small_stream_scene(), dir);
   StreamState cut;
   run_stream(s, [&](const StreamState& st) { cut = st; }, 1);
   // The names the writer will try, planted first: links to files outside, and dangling ones.
@@ -236,22 +237,21 @@ TEST(CheckpointTrust, LinksPlantedAtEveryTemporaryAndFinalNameAreNeverFollowed) 
                fs::exists(outside / "dangling-bin"));
   EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir / kCheckpointScene)));
   EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(dir / kCheckpointState)));
-  s.resume = true;
+  s.control.resume = true;
   EXPECT_EQ(read_checkpoint(dir, s), cut);
   fs::remove_all(dir), fs::remove_all(outside);
 }
 
 TEST(CheckpointTrust, AFailedWriteLeavesThePreviousCheckpointOrNone) {
   const fs::path dir = fresh_dir("fail");
-  Scene s = small_stream_scene();
-  s.out = dir;
+  const Plan s = checkpoint_plan(small_stream_scene(), dir);
   std::vector<StreamState> states;
   run_stream(s, [&](const StreamState& st) { states.push_back(st); });  // 1 checkpoint: after sphere 0
   ASSERT_EQ(states.size(), 1u);
   StreamState first = states[0], second = first;
   second.index_bytes += 1;  // another complete state of the same run
-  Scene r = s;
-  r.resume = true;
+  Plan r = s;
+  r.control.resume = true;
   // The n-th system call of the write fails (ENOSPC), for every n until a write goes through.
   for (const bool previous : {false, true}) {
     for (int n = 1;; ++n) {
@@ -284,13 +284,12 @@ TEST(CheckpointTrust, AFailedWriteLeavesThePreviousCheckpointOrNone) {
 
 TEST(CheckpointTrust, ALoneSceneFileSaysWhatToDo) {
   const fs::path dir = fresh_dir("lone");
-  Scene s = small_stream_scene();
-  s.out = dir;
-  write_file_atomic(dir / kCheckpointScene, to_toml(s));
+  Plan s = checkpoint_plan(small_stream_scene(), dir);
+  write_file_atomic(dir / kCheckpointScene, to_toml(s.given));
   std::string why = refusal([&] { check_checkpoint_files(s); });
   EXPECT_NE(why.find("without its state"), std::string::npos) << why;
   EXPECT_NE(why.find("remove it"), std::string::npos) << why;
-  s.resume = true;
+  s.control.resume = true;
   why = refusal([&] { check_checkpoint_files(s); });
   EXPECT_NE(why.find("nothing to continue"), std::string::npos) << why;
   fs::remove_all(dir);

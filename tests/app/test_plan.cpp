@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "asperity/app/plan.hpp"
@@ -42,7 +43,11 @@ bool has_test(const GeometryReport& r, const std::string& quantity) {
 
 TEST(Plan, EveryStageIsListedWithAReason) {
   for (const auto& name : preset_names()) {
-    const Plan p = make_plan(preset(name));
+    const Plan p = plan(preset(name));
+    if (p.kind != RunKind::sphere) {  // the other kinds list their stages as they run (run.cpp)
+      EXPECT_TRUE(p.stages.empty()) << name;
+      continue;
+    }
     std::vector<std::string> names;
     for (const auto& s : p.stages) {
       names.push_back(s.name);
@@ -56,7 +61,7 @@ TEST(Plan, EveryStageIsListedWithAReason) {
 TEST(Plan, SampledModeBuildsNoSphereAndNoIndex) {
   Scene s = preset("fig3");
   s.ensemble.mode = Mode::sampled;
-  const Plan p = make_plan(s);
+  const Plan p = plan(s);
   EXPECT_FALSE(p.runs("generate"));
   EXPECT_FALSE(p.runs("index"));
   EXPECT_FALSE(p.runs("cross_check"));
@@ -70,7 +75,7 @@ TEST(Plan, SampledModeBuildsNoSphereAndNoIndex) {
 }
 
 TEST(Plan, ExplicitDefaultBuildsSpheresIndexesAndCrossChecks) {
-  const Plan p = make_plan(preset("fig3"));
+  const Plan p = plan(preset("fig3"));
   EXPECT_TRUE(p.runs("generate"));
   EXPECT_TRUE(p.runs("index"));
   EXPECT_TRUE(p.runs("cross_check"));
@@ -91,7 +96,7 @@ TEST(Plan, ContactOnlySceneRunsNoImpactStage) {
   // are the same bits as with it.
   Scene with = small("fig4"), without = small("fig4");
   without.restitution_stats = false;
-  const Plan p = make_plan(without);
+  const Plan p = plan(without);
   EXPECT_FALSE(p.runs("impact"));
   EXPECT_FALSE(p.scene.ensemble.impact.enabled);
   const auto a = run_scene(with), b = run_scene(without);
@@ -126,19 +131,19 @@ TEST(Plan, AutoBackendScansFewRotationsAndIndexesMany) {
   Scene s = small("fig3-fixed");
   s.backend_auto = true;
   s.ensemble.spheres = 4000;  // one rotation per sphere
-  Plan p = make_plan(s);
+  Plan p = plan(s);
   EXPECT_EQ(p.scene.ensemble.backend, Backend::brute);
   EXPECT_FALSE(p.runs("index"));
   EXPECT_TRUE(p.runs("generate"));
   s.ensemble.spheres = 4000 / 40;  // 40 rotations per sphere >= kScanBelowRotations
-  p = make_plan(s);
+  p = plan(s);
   EXPECT_EQ(p.scene.ensemble.backend, Backend::grid);
   EXPECT_TRUE(p.runs("index"));
   // An explicit backend is honoured.
   s.backend_auto = false;
   s.ensemble.backend = Backend::kdtree;
   s.ensemble.spheres = 4000;
-  EXPECT_EQ(make_plan(s).scene.ensemble.backend, Backend::kdtree);
+  EXPECT_EQ(plan(s).scene.ensemble.backend, Backend::kdtree);
   // Brute and an index give the same bits (every backend is exact): the choice is free.
   s.ensemble.spheres = 400;  // 10 rotations
   s.backend_auto = true;
@@ -157,8 +162,8 @@ TEST(Plan, AutoBackendScansFewRotationsAndIndexesMany) {
 }
 
 TEST(Plan, PlotsOnlyWhenAsked) {
-  EXPECT_FALSE(make_plan(small("fig3")).runs("plots"));
-  EXPECT_TRUE(make_plan(preset("fig3")).runs("plots"));
+  EXPECT_FALSE(plan(small("fig3")).runs("plots"));
+  EXPECT_TRUE(plan(preset("fig3")).runs("plots"));
 }
 
 TEST(Plan, ReportEchoesTheSceneThatRan) {
@@ -168,4 +173,52 @@ TEST(Plan, ReportEchoesTheSceneThatRan) {
   const std::string json = to_json(r);
   EXPECT_NE(json.find("\"plan\""), std::string::npos);
   EXPECT_NE(json.find("\"scene_file\""), std::string::npos);
+}
+
+// Issue 35: one plan per run, and the plan alone says whether a run streams. The scene of the issue
+// (an impact scene with outputs.restitution = false, sampled, N = 1000, 4e7 drops): the planner
+// switches the impacts off, so statistics "auto" streams; the scene as written does not say so.
+TEST(Plan, ThePlanAloneDecidesThatARunStreams) {
+  Scene s = preset("fig4");
+  s.restitution_stats = false, s.plots = false;
+  s.ensemble.mode = Mode::sampled, s.ensemble.sphere.asperities = 1000, s.ensemble.drops = 40'000'000;
+  s.ensemble.statistics = Statistics::automatic;
+  ASSERT_FALSE(uses_streaming(s.ensemble)) << "as written: impacts on, so the old deciders took it for raw";
+  RunControl c;
+  c.share = {1, 4}, c.resume = false;
+  const Plan p = plan(s, c);
+  EXPECT_TRUE(p.streams);
+  EXPECT_FALSE(p.scene.ensemble.impact.enabled);
+  EXPECT_EQ(p.control.share, (StreamShare{1, 4})) << "a streaming run keeps its share";
+  // The wrong input: the same scene with its restitution output on keeps raw samples, and then
+  // neither a share nor --resume applies.
+  s.restitution_stats = true;
+  const Plan raw = plan(s, c);
+  EXPECT_FALSE(raw.streams);
+  EXPECT_EQ(raw.control.share, StreamShare{}) << "a run that does not stream is rank 0's alone";
+  c.resume = true;
+  try {
+    plan(s, c);
+    ADD_FAILURE() << "--resume of a run that does not stream was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("does not stream"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Plan, EveryRunIsPlannedOnce) {
+  // A sphere run, a streaming sphere run and a bounce run: each one plan, by run_scene_output.
+  Scene stream = small("fig3");
+  stream.ensemble.statistics = Statistics::streaming;
+  Scene bounce = preset("fig6");
+  bounce.plots = false, bounce.bounce.sequences = 20, bounce.bounce.variants = {bounce.bounce.variants.front()};
+  for (Scene s : {small("fig4"), stream, bounce}) {
+    s.out = std::filesystem::temp_directory_path() / "asperity-test-plan-once";
+    const std::uint64_t before = plans_made();
+    const SceneOutput o = run_scene_output(s, {}, nullptr, {});
+    EXPECT_EQ(plans_made() - before, 1u) << s.name << " (" << to_string(o.kind) << ")";
+    std::filesystem::remove_all(s.out);
+  }
+  const std::uint64_t before = plans_made();
+  run_scene(small("fig3"));
+  EXPECT_EQ(plans_made() - before, 1u) << "run_scene";
 }

@@ -79,7 +79,7 @@ std::string joined(const std::vector<std::string>& args) {
 asperity::MemoryEstimate estimate(std::vector<std::string> args, const fs::path& out) {
   for (const char* a : {"-q", "--no-plots", "--out"}) args.push_back(a);
   args.push_back(out.string());
-  return asperity::estimate_memory(asperity::cli::parse_command_line(args).scene);
+  return asperity::estimate_memory(asperity::plan(asperity::cli::parse_command_line(args).scene));
 }
 
 // The estimate of `args` against the measured peak of the run, within 25 %; both numbers stated.

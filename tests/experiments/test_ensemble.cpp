@@ -45,7 +45,7 @@ struct SceneRun {
 };
 SceneRun run(Scene s) {
   s.plots = false;
-  const Plan p = make_plan(s);
+  const Plan p = plan(s);
   SceneRun r{p.scene, run_contact_ensemble(p.scene.ensemble), {}};
   r.report = analyse(r.scene, r.samples);
   return r;

@@ -26,7 +26,7 @@ namespace {
 using namespace asperity;
 
 struct Fixture {
-  Scene scene = testing::small_stream_scene();
+  Plan scene = testing::checkpoint_plan(testing::small_stream_scene());
   StreamState cut, whole;
   std::string bytes;
   Fixture() {
@@ -80,7 +80,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } catch (const std::invalid_argument&) {
     return 0;  // refused, with a message naming the file
   }
-  if (!stream_state_problem(make_plan(f.scene).scene.ensemble, f.scene.share, st).empty())
+  if (!stream_state_problem(f.scene.scene.ensemble, f.scene.control.share, st).empty())
     fail("an inconsistent checkpoint was accepted");
   const StreamState end = testing::run_stream(f.scene, {}, 0, &st);  // throws (a crash here) on any error
   if (!fix_checksum && !(end == f.whole)) fail("an accepted checkpoint continued to another state");

@@ -21,7 +21,7 @@
 #include <string>
 #include <string_view>
 
-#include "asperity/app/scene.hpp"
+#include "asperity/app/plan.hpp"
 #include "asperity/experiments/streaming.hpp"
 
 namespace asperity {
@@ -29,42 +29,43 @@ namespace asperity {
 inline constexpr const char* kCheckpointScene = "checkpoint.toml";
 inline constexpr const char* kCheckpointState = "checkpoint.bin";
 
-/// What must match between a checkpoint and the run that continues it: the scene as TOML with
-/// the run-control fields (threads, plots, out) cleared, and the design make_plan resolves from it
-/// (spheres and backend "auto").
-std::string checkpoint_key(const Scene& s);
+/// What must match between a checkpoint and the run that continues it: the scene as given, as TOML
+/// with the fields that change no result (threads, plots, out) cleared, and the design the plan
+/// resolved from it (spheres and backend "auto").
+std::string checkpoint_key(const Plan& p);
 
-/// The state file of s.share: checkpoint.bin for one process, checkpoint.rank-R-of-P.bin otherwise.
+/// The state file of a share: checkpoint.bin for one process, checkpoint.rank-R-of-P.bin otherwise.
 std::string checkpoint_state_name(const StreamShare& share);
 
 /// Whether `name` is a checkpoint file's name (checkpoint.toml, checkpoint.bin,
 /// checkpoint.rank-R-of-P.bin): output_name_problem refuses such names for outputs.
 bool is_checkpoint_name(std::string_view name);
 
-/// Writes the scene (rank 0 only) and s.share's state into `dir`. Throws std::runtime_error naming
+/// Writes the scene (rank 0 only) and p.control.share's state into `dir`. Throws std::runtime_error naming
 /// the file; then `dir` holds the previous complete checkpoint, or none.
-void write_checkpoint(const std::filesystem::path& dir, const Scene& s, const StreamState& st);
+void write_checkpoint(const std::filesystem::path& dir, const Plan& p, const StreamState& st);
 
-/// Reads s.share's state file in `dir`; throws std::invalid_argument naming the file when it is
+/// Reads p.control.share's state file in `dir`; throws std::invalid_argument naming the file when it is
 /// missing, not a regular file, of another size, damaged, of another format, written for another
 /// scene, or inconsistent (see the top of this file).
-StreamState read_checkpoint(const std::filesystem::path& dir, const Scene& s);
+StreamState read_checkpoint(const std::filesystem::path& dir, const Plan& p);
 
-/// Up front, before the output directory is touched (throws std::invalid_argument, saying what to
-/// do): a resumed run's checkpoint is read whole (read_checkpoint); a new streaming run refuses a
-/// directory holding checkpoint files (an interrupted run's, or a scene file without its state).
-void check_checkpoint_files(const Scene& s);
+/// plan()'s check of a streaming run, before the output directory is touched (throws
+/// std::invalid_argument, saying what to do): a resumed run's checkpoint is read whole
+/// (read_checkpoint); a new run refuses a directory holding checkpoint files (an interrupted run's,
+/// or a scene file without its state). A run that does not stream (p.streams false): nothing.
+void check_checkpoint_files(const Plan& p);
 
 /// A state as bytes (the state file's format) and back. `what` names the source in messages.
-std::string stream_state_bytes(const Scene& s, const StreamState& st);
-StreamState stream_state_from_bytes(const std::string& bytes, const Scene& s, const std::string& what);
+std::string stream_state_bytes(const Plan& p, const StreamState& st);
+StreamState stream_state_from_bytes(const std::string& bytes, const Plan& p, const std::string& what);
 
 /// The checksum a state file ends with (CRC-64/XZ of every byte before it): for tests that craft
 /// well-formed but inconsistent files.
 std::uint64_t checkpoint_checksum(std::string_view bytes);
 
-/// The size of every state file of scene s (the format has no optional parts).
-std::size_t checkpoint_state_size(const Scene& s);
+/// The size of every state file of plan p (the format has no optional parts).
+std::size_t checkpoint_state_size(const Plan& p);
 
 /// Removes the scene file and the state files of s.share.ranks processes if present (a completed
 /// run's own checkpoint, or the one it continued).

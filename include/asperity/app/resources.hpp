@@ -7,7 +7,7 @@
 #include <string>
 
 #include "asperity/app/cor_table.hpp"
-#include "asperity/app/scene.hpp"
+#include "asperity/app/plan.hpp"
 
 namespace asperity {
 
@@ -16,12 +16,12 @@ struct MemoryEstimate {
   std::string detail;   ///< what it is made of, for the message ("3 spheres x 2e7 asperities x 73 B (grid) + ...")
 };
 
-/// The estimated peak RSS of running `s` as validate-geometry does, figures not counted (drawn
+/// The estimated peak RSS of running plan `p` (its design as planned) as validate-geometry does, figures not counted (drawn
 /// in-process by PLplot after the samples: ~17 MB more, measured 32.0 against 15.3 MB for N = 1000,
 /// 2000 drops). Costs measured on x86-64 (docs/cli.md, Memory); within 25 % of the measured peak for
 /// runs whose variable part dominates, one test per kind of run (tests/app/test_resources.cpp). A
 /// mesh body's size is read from its file's header (mesh_file_size): nothing is parsed here.
-MemoryEstimate estimate_memory(const Scene& s);
+MemoryEstimate estimate_memory(const Plan& p);
 
 /// The memory this process may use: physical RAM, lowered to what the kernel has available now
 /// (MemAvailable), a cgroup limit (memory.max) or RLIMIT_AS when set. 0 when unknown.
@@ -33,8 +33,8 @@ struct MemoryRefused : std::invalid_argument {
 };
 
 /// Throws MemoryRefused naming the values that drive the estimate when it exceeds
-/// memory_limit_bytes(): the run is refused before it starts.
-void check_memory(const Scene& s);
+/// memory_limit_bytes(): the run is refused before it starts (plan() calls it).
+void check_memory(const Plan& p);
 
 /// Bytes of an explicit sphere of `asperities` centres with a contact index of backend `b`
 /// (brute: the centres alone), as estimate_memory counts them.
@@ -48,9 +48,5 @@ double cor_table_bytes(const CorTableSpec& spec);
 /// ("make_rough_sphere: 1000000000 asperities x 24 B"), `lower` the parameters that decide.
 void check_bytes(double bytes, const std::string& what, const std::string& lower);
 
-/// The one check before a run touches anything (validate-geometry, asperity.run, run_scene_output):
-/// validate(s), check_memory(s) -- before any mesh is read --, then check_scene_inputs(s).
-/// Throws MemoryRefused or std::invalid_argument naming the key.
-void check_run(const Scene& s);
 
 }  // namespace asperity

@@ -85,13 +85,8 @@ struct Scene {
   bool restitution_stats = true;
   std::filesystem::path out = "asperity-out";
   std::string report = "report.json";  ///< report file name inside `out`
-  /// Streaming runs only, how this run is driven (not written to scene files): a checkpoint every
-  /// checkpoint_seconds (0: only on SIGINT/SIGTERM) in `out`; resume: continue from it (app/checkpoint.hpp).
-  double checkpoint_seconds = 300;
-  bool resume = false;
-  /// This process's share of a run split across processes (validate-geometry under mpirun;
-  /// streaming runs only, experiments/streaming.hpp). Not written to scene files.
-  StreamShare share;
+  // How a run is driven (--resume, the share of a split run, the checkpoint interval) is not
+  // scene data: RunControl (plan.hpp).
 
   friend bool operator==(const Scene&, const Scene&) = default;
 

@@ -29,11 +29,11 @@ GeometryReport analyse_stream(const Scene& scene, const ContactStream& s);
 /// blocks of spheres) against the predicted F_exact - F_Eq14.
 BandFigure finite_n_figure(const Scene& scene, const ContactStream& s);
 
-/// run_scene's streaming branch (uses_streaming): the stream, its analysis, the finite-N figure
-/// (finite_n.png in `dir`, default s.out, when plots are planned) and the plan with stage times.
-/// `group` (rank 0 of a split run, s.share its share): the other processes' shares are gathered
+/// run_scene's streaming branch (p.streams): the stream, its analysis, the finite-N figure
+/// (finite_n.png in `dir`, default the scene's out, when plots are planned) and the plan with stage
+/// times. `group` (rank 0 of a split run, p.control.share its share): the other processes' shares are gathered
 /// and merged before the analysis; the report is the same bits as one process's (timings aside).
-GeometryReport run_stream_scene(Plan plan, const Scene& s, const Progress& progress, const std::filesystem::path& dir,
+GeometryReport run_stream_scene(const Plan& p, const Progress& progress, const std::filesystem::path& dir,
                                 const StreamHooks& hooks = {}, const StreamState* resume = nullptr,
                                 Collective* group = nullptr);
 
@@ -43,9 +43,9 @@ struct StreamEnded : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// A process of rank > 0 of a split run: runs its share s.share of the planned stream (with its own
+/// A process of rank > 0 of a split run: runs its share p.control.share of the planned stream (with its own
 /// checkpoints) and sends it to rank 0. Throws as rank 0's run does when any process failed or
 /// stopped (std::runtime_error), so every process ends with the same outcome.
-void run_stream_share(const Scene& s, Collective& group);
+void run_stream_share(const Plan& p, Collective& group);
 
 }  // namespace asperity

@@ -467,28 +467,18 @@ void apply_tangential_option(Scene& scene, const RawOptions& r, const OptionKind
 }
 
 // --statistics, --bins-log2 (sphere contact runs), --checkpoint-every (streaming runs).
-void apply_streaming_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
+void apply_streaming_options(Scene& scene, RunControl& control, const RawOptions& r, const Given& given,
+                             const OptionKind& k) {
   auto& e = scene.ensemble;
   if (given("--checkpoint-every")) {
-    scene.checkpoint_seconds = parse_real("--checkpoint-every", r.checkpoint_every);
-    if (!(scene.checkpoint_seconds >= 0) || !std::isfinite(scene.checkpoint_seconds))
+    control.checkpoint_seconds = parse_real("--checkpoint-every", r.checkpoint_every);
+    if (!(control.checkpoint_seconds >= 0) || !std::isfinite(control.checkpoint_seconds))
       throw BadInput("--checkpoint-every: '" + r.checkpoint_every + "' must be a finite number of seconds >= 0");
   }
   if (given("--statistics")) e.statistics = parse_statistics(r.statistics);
   if (given("--bins-log2")) e.bins_log2 = static_cast<unsigned>(parse_count("--bins-log2", r.bins_log2, 10, 24));
   if ((given("--statistics") || given("--bins-log2")) && (k.bounce || k.mesh || k.radii))
     refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
-}
-
-// --checkpoint-every and --bins-log2 act on streaming statistics only: on a run that keeps raw
-// samples (as planned: statistics auto streams above 2^25 drops without impacts) they would be
-// silently ignored, so they are refused. Checked on the validated scene, after every option.
-void refuse_unused_streaming_options(const Scene& scene, const Given& given) {
-  if (!given("--checkpoint-every") && !given("--bins-log2")) return;
-  if (run_kind(scene) == RunKind::sphere && uses_streaming(make_plan(scene).scene.ensemble)) return;
-  refuse(given("--checkpoint-every") ? "--checkpoint-every" : "--bins-log2",
-         "acts on streaming statistics only, and this run keeps raw samples (give --statistics streaming, or leave "
-         "the option out)");
 }
 
 // --kernel: the drop kernel of explicit sphere drops. It changes no bit, so it may come with
@@ -546,11 +536,11 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
 
 // The preset or scene file, then the options over it (docs/scenes.md), in this order: the kind of
 // run is taken after --asperity-radius, which can turn a radii run into the paper's.
-Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoader& load) {
+Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoader& load, RunControl& control) {
   if (given("--resume")) check_resume_option(r, given);
   const std::string path = given("--resume") ? (std::filesystem::path(r.resume) / "checkpoint.toml").string() : r.scene_file;
   Scene scene = !given("--scene") && !given("--resume") ? preset(r.preset_name) : load ? load(path) : load_scene(path);
-  if (given("--resume")) scene.out = r.resume, scene.resume = true;
+  if (given("--resume")) scene.out = r.resume, control.resume = true;
   apply_body_options(scene, r, given);
   const OptionKind k = option_kind(scene);
   apply_design_options(scene, r, given, k);
@@ -559,11 +549,9 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   if (given("--kernel")) apply_kernel_option(scene, r, k);
   apply_bounce_options(scene, r, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
-  apply_streaming_options(scene, r, given, k);
+  apply_streaming_options(scene, control, r, given, k);
   apply_run_options(scene, r, given);
-  validate(scene);
-  refuse_unused_streaming_options(scene, given);
-  return scene;
+  return scene;  // the cross-key rules: plan() (plan.hpp), once per run
 }
 
 }  // namespace
@@ -591,8 +579,12 @@ Options parse_command_line(std::span<const std::string> args, const SceneLoader&
       break;
   }
   try {
-    o.scene = scene_with_options(raw, Given{app}, load);
+    o.scene = scene_with_options(raw, Given{app}, load, o.control);
     o.quiet = raw.quiet;
+    // Acting on streaming statistics only: refused by validate-geometry when the plan keeps raw
+    // samples (statistics auto streams above 2^25 drops without impacts).
+    for (const char* opt : {"--checkpoint-every", "--bins-log2"})
+      if (app.count(opt) > 0) o.streaming_only.emplace_back(opt);
     return o;
   } catch (const BadInput&) {
     throw;

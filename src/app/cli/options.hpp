@@ -6,8 +6,9 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
-#include "asperity/app/scene.hpp"
+#include "asperity/app/plan.hpp"
 
 namespace asperity::cli {
 
@@ -17,15 +18,19 @@ struct BadInput : std::runtime_error {
 };
 
 struct Options {
-  Scene scene;             ///< validated (asperity::validate) unless `help`
+  Scene scene;             ///< each key checked; its cross-key rules are plan()'s (plan.hpp)
+  RunControl control;      ///< --resume, --checkpoint-every (the share is the caller's)
+  /// The options given that act on streaming statistics only (--checkpoint-every, --bins-log2):
+  /// validate-geometry refuses them when the run's plan keeps raw samples.
+  std::vector<std::string> streaming_only;
   bool quiet = false;      ///< --quiet: no progress lines
   bool help = false;       ///< --help or --version was given: print help_text, exit 0, nothing else
   std::string help_text;
 };
 
 /// Parses the arguments after the program name. Throws BadInput (and only BadInput) for any bad
-/// option or value: unknown options, malformed/non-finite/out-of-range numbers, scenes that fail
-/// validate(). No files are written; `--scene FILE` is read through `load` (load_scene by default;
+/// option or value: unknown options, malformed/non-finite/out-of-range numbers, options that do not
+/// apply to the scene's kind of run. The scene's cross-key rules are checked once, by plan(). No files are written; `--scene FILE` is read through `load` (load_scene by default;
 /// the fuzz target passes its own, so that fuzzing never touches the file system).
 using SceneLoader = std::function<Scene(const std::string& file)>;
 Options parse_command_line(std::span<const std::string> args, const SceneLoader& load = {});

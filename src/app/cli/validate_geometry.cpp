@@ -43,37 +43,31 @@ using asperity::cli::ProgressLine;
 
 namespace {
 
-// Whether run_scene will stream this scene: the planned ensemble decides, as in run_scene (only
-// such runs are split across processes). A scene that does not validate is refused later, with
-// validate's message.
-bool streams(const Scene& s) {
-  if (run_kind(s) != RunKind::sphere) return false;
-  try {
-    return uses_streaming(make_plan(s).scene.ensemble);
-  } catch (const std::invalid_argument&) {
-    return false;
-  }
-}
-
-// The command line, checked as far as it can be before the output directory is touched. Returns
-// the exit status when the run ends here (--help: 0; bad input: 2). `share`: this process's share
-// of a split run (its checkpoint file is checked); only rank 0 prints help and errors.
-std::optional<int> read_command_line(int argc, char** argv, Scene& scene, bool& quiet, const StreamShare& share,
-                                     std::string& error) {
+// The command line, checked as far as it can be before the output directory is touched, and
+// planned (plan(), plan.hpp: the one place that decides how the run goes). Returns the exit status
+// when the run ends here (--help: 0; bad input: 2). `share`: this process's share of a split run
+// (its checkpoint file is checked); only rank 0 prints help and errors.
+std::optional<int> read_command_line(int argc, char** argv, std::optional<Plan>& planned, bool& quiet,
+                                     const StreamShare& share, std::string& error) {
   try {
     const std::vector<std::string> args(argv + 1, argv + argc);
-    const cli::Options o = cli::parse_command_line(args);
+    cli::Options o = cli::parse_command_line(args);
     if (o.help) {
       if (share.rank == 0) std::cout << o.help_text;
       return 0;
     }
-    scene = o.scene;
-    scene.share = share.ranks > 1 && streams(scene) ? share : StreamShare{};
     quiet = o.quiet || share.rank > 0;
-    if (scene.plots && share.rank == 0)  // only rank 0 draws
-      if (const std::string why = plotting_problem(parse_plot_formats(scene.plot_format)); !why.empty())
+    if (o.scene.plots && share.rank == 0)  // only rank 0 draws
+      if (const std::string why = plotting_problem(parse_plot_formats(o.scene.plot_format)); !why.empty())
         throw BadInput("figures cannot be drawn: " + why + "; or pass --no-plots");
-    check_run(scene);  // the same check as run_scene_output's, before the output directory is touched
+    o.control.share = share;  // plan() keeps it for a streaming run only
+    planned.emplace(plan(std::move(o.scene), o.control));
+    // Options that act on streaming statistics only would be silently ignored by a run that keeps
+    // raw samples: refused, by the plan's answer.
+    if (!planned->streams && !o.streaming_only.empty())
+      throw BadInput(o.streaming_only.front() +
+                     ": acts on streaming statistics only, and this run keeps raw samples (give --statistics "
+                     "streaming, or leave the option out)");
   } catch (const std::exception& ex) {
     error = ex.what();
     return 2;
@@ -115,7 +109,8 @@ void print_outcome(const Scene& scene, const SceneOutput& r, const std::vector<f
 // place only when the whole run succeeded (the report last): a failed or interrupted run
 // leaves the directory as it found it (output_staging.hpp). `staging_dir` is set as soon as it
 // exists, for the messages. Returns the exit status.
-int run_staged(const Scene& scene, bool quiet, std::string& staging_dir, Collective* group) {
+int run_staged(const Plan& p, bool quiet, std::string& staging_dir, Collective* group) {
+  const Scene& scene = p.scene;
   std::optional<OutputStaging> staging;
   try {
     staging.emplace(scene.out);
@@ -132,20 +127,20 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir, Collect
   } catch (const std::exception& ex) {
     throw BadInput(ex.what());
   }
-  // Checked again under the directory's lock: a run that ended between check_run and the lock
+  // Checked again under the directory's lock: a run that ended between plan() and the lock
   // may have left its checkpoint here, which this run must neither overwrite nor remove.
-  if (!scene.resume && uses_streaming(scene.ensemble)) {
+  if (!p.control.resume && p.streams) {
     try {
-      check_checkpoint_files(scene);
+      check_checkpoint_files(p);
     } catch (const std::exception& ex) {
       throw BadInput(ex.what());
     }
   }
-  const bool sequences = run_kind(scene) == RunKind::mesh_bounce || run_kind(scene) == RunKind::bounce;
+  const bool sequences = p.kind == RunKind::mesh_bounce || p.kind == RunKind::bounce;
   ProgressLine progress(!quiet, stderr, ::isatty(2) != 0, &ProgressLine::steady_seconds, 1.0,
                         sequences ? "sequences" : "drops");
   ProgressLine::Log log(progress);
-  const SceneOutput r = run_scene_output(scene, std::ref(progress), quiet ? nullptr : &log, staging->dir(), group);
+  const SceneOutput r = run_plan(p, std::ref(progress), quiet ? nullptr : &log, staging->dir(), group);
   progress.finish();
   for (const auto& f : r.files) staging->add(f);
   const auto reports = write_report_files(staging->dir(), scene.report, r.json, r.table);
@@ -153,7 +148,7 @@ int run_staged(const Scene& scene, bool quiet, std::string& staging_dir, Collect
   staging->add(reports.at(0).filename().string());
   staging->commit();
   // Under the lock still: this run's checkpoint (or the one it continued), no other run's.
-  if (uses_streaming(scene.ensemble)) remove_checkpoint(scene.out, scene.share);
+  if (p.streams) remove_checkpoint(scene.out, p.control.share);
   staging.reset();
   print_outcome(scene, r, reports);
   return r.rejected ? 1 : 0;
@@ -167,10 +162,11 @@ std::string in_place(std::string message, const std::string& staging_dir, const 
 }
 
 // Rank 0 of a split run, or the only process: runs and reports the scene. Returns the exit status.
-int run_reporting(const Scene& scene, bool quiet, Collective* group) {
+int run_reporting(const Plan& p, bool quiet, Collective* group) {
+  const Scene& scene = p.scene;
   std::string staging_dir;
   try {
-    return run_staged(scene, quiet, staging_dir, group);
+    return run_staged(p, quiet, staging_dir, group);
   } catch (const std::bad_alloc&) {
     std::cerr << "validate-geometry: error: out of memory for " << scene.ensemble.sphere.asperities << " asperities x "
               << scene.ensemble.drops << " drops (" << to_string(scene.ensemble.mode) << " mode); "
@@ -201,20 +197,20 @@ class CountedSteps final : public Collective {
 
 // The processes of a split run: rank 0 reports (a scene that does not stream runs on rank 0 alone),
 // the others run their share of the stream; all end with rank 0's exit status.
-int run_split(const Scene& scene, bool quiet, Collective& world) {
+int run_split(const Plan& p, bool quiet, Collective& world) {
   CountedSteps group(world);
-  const bool split = scene.share.ranks > 1;
+  const bool split = p.control.share.ranks > 1;
   int status = 0;
   if (group.rank() == 0) {
     if (!split)
       std::cerr << "validate-geometry: note: this scene does not stream (statistics = raw, or not a contact ensemble): "
                    "rank 0 runs it alone (--statistics streaming splits a contact ensemble across the processes)\n";
-    status = run_reporting(scene, quiet, split ? &group : nullptr);
+    status = run_reporting(p, quiet, split ? &group : nullptr);
     // Failed before the stream's outcome was agreed: take part in it, as failed.
     if (split && group.steps == 0) group.max(2);
   } else if (split) {
     try {
-      run_stream_share(scene, group);
+      run_stream_share(p, group);
     } catch (const StreamEnded&) {
       status = 2;  // told already: by rank 0 (a stop) or by the process that failed
     } catch (const std::exception& ex) {
@@ -246,12 +242,12 @@ int run_main(int argc, char** argv) {
     return 2;
   }
   const StreamShare share = world ? StreamShare{world->rank(), world->size()} : StreamShare{};
-  Scene scene;
+  std::optional<Plan> planned;  // the run's one plan
   bool quiet = false;
   // Everything that can be checked is checked before the output directory is touched (by every
   // process: each checks its own checkpoint file; all stop when one finds a fault).
   std::string error;
-  const std::optional<int> status = read_command_line(argc, argv, scene, quiet, share, error);
+  const std::optional<int> status = read_command_line(argc, argv, planned, quiet, share, error);
   if (world && world->max(status ? (*status == 0 ? 1 : 2) : 0) != 0) {
     // One message: rank 0's, or (when only other processes refused, e.g. a missing checkpoint of
     // theirs) each of theirs.
@@ -265,8 +261,8 @@ int run_main(int argc, char** argv) {
     if (!error.empty()) std::cerr << "validate-geometry: error: " << shown(error) << "\n";
     return *status;
   }
-  if (world) return run_split(scene, quiet, *world);
-  return run_reporting(scene, quiet, nullptr);
+  if (world) return run_split(*planned, quiet, *world);
+  return run_reporting(*planned, quiet, nullptr);
 }
 
 }  // namespace
