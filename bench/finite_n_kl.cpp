@@ -59,7 +59,9 @@ json measured_row(const std::string& path) {
 }
 
 Figure kl_figure(const json& rows, const json& measured) {
-  LineSeries exact{"KL(exact || Eq. 14), laws/theory.hpp"}, asym{"9 / N^2"};
+  LineSeries exact, asym;
+  exact.label = "KL(exact || Eq. 14), laws/theory.hpp";
+  asym.label = "9 / N^2";
   asym.dash = Dash::dashed;
   asym.colour = kOkabeIto[1];
   for (double e = 1.5; e <= 6.0001; e += 0.05) {
@@ -69,7 +71,8 @@ Figure kl_figure(const json& rows, const json& measured) {
     asym.x.push_back(n);
     asym.y.push_back(9.0 / (n * n));
   }
-  PointSeries pts{"measured L +- se (explicit geometry, streaming)"};
+  PointSeries pts;
+  pts.label = "measured L +- se (explicit geometry, streaming)";
   for (const auto& m : measured) {
     pts.x.push_back(m.at("N").get<double>());
     pts.y.push_back(m.at("L").get<double>());

@@ -282,7 +282,7 @@ TEST(ResourcesPeak, LargeFigures) {
   if (!asperity::plotting_available()) GTEST_SKIP() << "figures cannot be drawn here";
   const fs::path out = asperity::testing::fresh_dir("resources", "png8");
   const std::vector<std::string> args = {"-q", "--asperities", "1000", "--drops", "2000", "--plot-format", "png@8", "--out", out.string()};
-  const asperity::MemoryEstimate est = asperity::estimate_memory(asperity::cli::parse_command_line(args).scene);
+  const asperity::MemoryEstimate est = asperity::estimate_memory(asperity::plan(asperity::cli::parse_command_line(args).scene));
   const pid_t pid = asperity::testing::spawn_cli(VALIDATE_GEOMETRY, args, out.string() + ".log");
   int st = 0;
   struct rusage ru {};
