@@ -410,7 +410,9 @@ void draw(const Figure& fig, Palette& pal) {
   // The left margin holds the widest panel's y title (its outer half-height beyond its centre).
   PLFLT char_mm = 0, ht_mm = 0;
   plgchr(&char_mm, &ht_mm);
-  const double char_px = ht_mm / 25.4 * 90.0;  // one character height in pixels of the scale-1 page
+  // One character height in pixels of the scale-1 page: plgchr answers in millimetres of the page as
+  // drawn, whose resolution (and so the characters' size in mm) grows with the size factor @S.
+  const double char_px = ht_mm / 25.4 * 90.0 / fig.resolution_scale;
   double title_disp = 0;
   for (const Panel& p : fig.panels) {
     const auto [ya, yb] = y_range(p);
