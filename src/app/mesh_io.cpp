@@ -242,17 +242,27 @@ void check_ply_lists(const std::filesystem::path& file, std::uint64_t size) {
   int format = -1;  // 0 ascii, 1 little endian, 2 big endian
   std::vector<PlyElement> elements;
   std::uint64_t vertices = 0;
+  // A header this check cannot follow is refused, not passed on: CGAL reads such files anyway
+  // (a first line "\x01ply", a property of type "floax"), with list counts nobody bounded
+  // (fuzz_mesh_file: 4e9-element lists from a misparsed layout, out of memory).
+  const auto refuse = [&](const std::string& why) {
+    throw std::invalid_argument("mesh file '" + file.string() + "': " + why +
+                                " (PLY headers are checked before reading: ply, format, element, property lines)");
+  };
   for (bool first = true; in.line(l); first = false) {
     if (!l.empty() && l.back() == '\r') l.pop_back();
-    if (first && l != "ply") return;
+    if (first && l != "ply") refuse("the first line is not \"ply\"");
     std::istringstream w(l);
     std::string kw, a, b, c;
     w >> kw;
     if (kw == "end_header") break;
+    if (kw != "format" && kw != "element" && kw != "property" && kw != "comment" && kw != "obj_info" && !(first && kw == "ply"))
+      refuse("a header line that is not ply, format, comment, obj_info, element or property: '" + detail::escaped(l) + "'");
+    if (kw == "property" && elements.empty()) refuse("a property before any element");
     if (kw == "format" && w >> a) format = a == "ascii" ? 0 : a == "binary_little_endian" ? 1 : a == "binary_big_endian" ? 2 : -1;
     if (kw == "element" && w >> a >> b) {
       const auto rows = count_of(b);
-      if (!rows) return;
+      if (!rows) refuse("element '" + a + "' has no readable count");
       elements.push_back({a, *rows, {}});
       if (a == "vertex") vertices = *rows;
     }
@@ -260,16 +270,16 @@ void check_ply_lists(const std::filesystem::path& file, std::uint64_t size) {
       PlyProperty p;
       if (a == "list" && w >> b >> c) {
         p.count_size = ply_type_size(b), p.size = ply_type_size(c);
-        if (p.count_size == 0 || p.size == 0) return;
+        if (p.count_size == 0 || p.size == 0) refuse("a list property of unknown type (" + b + ", " + c + ")");
       } else {
         p.size = ply_type_size(a);
-        if (p.size == 0) return;
+        if (p.size == 0) refuse("a property of unknown type '" + a + "'");
       }
       w >> p.name;
       elements.back().props.push_back(p);
     }
   }
-  if (format < 0) return;
+  if (format < 0) refuse("no known format line (ascii, binary_little_endian, binary_big_endian)");
   std::string tok;
   unsigned char buf[8];
   for (const auto& e : elements)
@@ -305,6 +315,28 @@ void check_list_counts(const std::filesystem::path& file, std::uint64_t size) {
   if (ext == ".ply") check_ply_lists(file, size);
 }
 
+// CGAL's read_polygon_mesh (CGAL 5.5, Polygon_mesh_processing/IO/polygon_mesh_io.h) step by step,
+// with one check it lacks: every face's vertex index names a vertex of the file. repair_polygon_soup
+// indexes the points with the file's indices unchecked, so a PLY face naming vertex -889192445 read
+// outside the point array (found by fuzz_mesh_file). Same steps, same mesh otherwise.
+bool read_checked_soup(const std::string& f, CGAL::Surface_mesh<CGAL::Exact_predicates_inexact_constructions_kernel::Point_3>& sm) {
+  namespace PMP = CGAL::Polygon_mesh_processing;
+  std::vector<CGAL::Exact_predicates_inexact_constructions_kernel::Point_3> points;
+  std::vector<std::vector<std::size_t>> faces;
+  if (!CGAL::IO::read_polygon_soup(f, points, faces)) return false;
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (const std::size_t v : faces[i])
+      if (v >= points.size())
+        throw std::invalid_argument("mesh file '" + f + "': face " + std::to_string(i) + " names vertex " +
+                                    std::to_string(static_cast<long long>(v)) + ", but the file has " +
+                                    std::to_string(points.size()) + " vertices");
+  PMP::repair_polygon_soup(points, faces);
+  PMP::orient_polygon_soup(points, faces);
+  if (!PMP::is_polygon_soup_a_polygon_mesh(faces)) return false;
+  PMP::polygon_soup_to_polygon_mesh(points, faces, sm);
+  return true;
+}
+
 }  // namespace
 
 TriangleMesh read_mesh(const std::filesystem::path& file, double scale) {
@@ -323,7 +355,7 @@ TriangleMesh read_mesh(const std::filesystem::path& file, double scale) {
   Mesh sm;
   bool read = false;
   try {
-    read = CGAL::Polygon_mesh_processing::IO::read_polygon_mesh(f, sm);
+    read = read_checked_soup(f, sm);
   } catch (const std::bad_alloc&) {
     throw std::invalid_argument("mesh file '" + f + "': not enough memory to read it (" + std::to_string(size) + " bytes)");
   }
