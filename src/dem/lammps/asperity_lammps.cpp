@@ -12,7 +12,9 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <algorithm>
 #include <map>
+#include <vector>
 
 #include "atom.h"
 #include "comm.h"
@@ -36,8 +38,9 @@ namespace asperity_dem {
 // ---- Draw: keywords, table, log ----
 
 int Draw::keyword(int n, char** args, int i, std::string& why) {
-  const std::string k = args[i];
-  if (k != "table" && k != "constant" && k != "seed" && k != "scale_damping" && k != "log") return 0;
+  std::string k = args[i];
+  if (k == "cortable") k = "table";  // the same keyword under a name that is no LAMMPS pair style (pair_style hybrid)
+  if (k != "table" && k != "constant" && k != "seed" && k != "scale_damping" && k != "log" && k != "outside") return 0;
   if (i + 1 >= n) {
     why = "keyword '" + k + "' needs a value";
     return -1;
@@ -49,6 +52,12 @@ int Draw::keyword(int n, char** args, int i, std::string& why) {
     constant_ = -1.0;  // no constant: the table decides (lets an input script pass both)
   } else if (k == "table") {
     table_path_ = v;
+  } else if (k == "outside") {
+    if (std::strcmp(v, "clamp") != 0 && std::strcmp(v, "error") != 0) {
+      why = std::string("outside '") + v + "': clamp or error";
+      return -1;
+    }
+    refuse_outside_ = std::strcmp(v, "error") == 0;
   } else if (k == "log") {
     log_path_ = std::strcmp(v, "none") == 0 ? "" : v;
   } else if (k == "seed") {
@@ -84,7 +93,8 @@ int Draw::keyword(int n, char** args, int i, std::string& why) {
 bool Draw::finish(int rank, std::string& why) {
   if (constant_ >= 0.0) table_path_.clear();  // 'constant EPS' wins over 'table FILE'
   if (table_path_.empty() && constant_ < 0.0) {
-    why = "give 'table FILE' (eps drawn per contact) or 'constant EPS' (one eps for every contact)";
+    why = "give 'table FILE' (eps drawn per contact) or 'constant EPS' (one eps for every contact); under pair_style "
+          "hybrid write 'cortable FILE': hybrid starts LAMMPS's pair style 'table' at the word table";
     return false;
   }
   if (!table_path_.empty() && !have_seed_) {
@@ -108,7 +118,7 @@ bool Draw::finish(int rank, std::string& why) {
       why = "log '" + path + "': cannot create it (" + std::strerror(errno) + "; it must not exist yet)";
       return false;
     }
-    std::fprintf(log_, "# step kind id_a id_b approach_speed_m_s u eps gamma_n_kg_s\n");
+    std::fprintf(log_, "# step kind id_a id_b approach_speed_m_s u eps gamma_n flag\n");
   }
   return true;
 }
@@ -182,6 +192,42 @@ void require_sphere(LAMMPS* lmp, const char* who) {
   if (!atom->tag_enable) fail(lmp, std::string(who) + " needs atom IDs (they key the per-contact stream)");
 }
 
+// The table's speeds are m/s: the factor from the input's velocity unit to m/s, for the unit styles
+// whose force, mass, length and time are consistent without a conversion constant (force->ftm2v == 1,
+// so that gamma = f(eps) sqrt(m k) is in the input's force/velocity unit). Other styles are refused.
+double speed_unit_si(LAMMPS* lmp, const char* who) {
+  const std::string u = lmp->update->unit_style;
+  double f = 0.0;
+  if (u == "si") f = 1.0;
+  else if (u == "cgs") f = 0.01;               // cm/s
+  else if (u == "micro" || u == "nano") f = 1.0;  // micrometer/microsecond, nanometer/nanosecond
+  if (f == 0.0 || lmp->force->ftm2v != 1.0)
+    fail(lmp, std::string(who) + ": 'units " + u +
+                  "' is not supported: the table's speeds are m/s; use units si, cgs, micro or nano");
+  return f;
+}
+
+// The end-of-run line: how many contacts began, and how their eps was found (all ranks call it).
+void summary(LAMMPS* lmp, const std::string& who, Draw& draw, bool pair) {
+  Counts& c = draw.counts();
+  double local[5] = {c.n[0], c.n[1], c.n[2], c.n[3], c.remote}, all[5];
+  MPI_Allreduce(local, all, 5, MPI_DOUBLE, MPI_SUM, lmp->world);
+  c = Counts{};
+  const double begun = all[0] + all[1] + all[2] + all[3];
+  if (lmp->comm->me != 0) return;
+  char line[640];
+  const asperity_cor_table* t = draw.table();
+  std::snprintf(line, sizeof line,
+                "%s: %.0f contacts begun in this run: %.0f within the table's speeds, %.0f below them (drawn from "
+                "the %g m/s row), %.0f above them (drawn from the %g m/s row), %.0f first seen separating (no impact: "
+                "eps %.6g)%s",
+                who.c_str(), begun, all[0], all[1], t ? t->speeds[0] : 0.0, all[2], t ? t->speeds[t->n_speeds - 1] : 0.0,
+                all[3], draw.fallback(), pair ? "" : "\n");
+  std::string msg = line;
+  if (pair) msg += "; " + std::to_string(static_cast<long long>(all[4])) + " with the partner on another rank\n";
+  utils::logmesg(lmp, msg);
+}
+
 }  // namespace
 
 // ---- FixRecords ----
@@ -202,14 +248,48 @@ FixRecords::FixRecords(LAMMPS* lmp, int narg, char** arg, int slots, int width)
 
 void FixRecords::allocate() {
   maxexchange = slots_ * width_;
+  restart_peratom = 1;   // the records go into restart files (pack_restart) and come back (unpack_restart)
+  create_attribute = 1;  // atoms created during a run (fix pour, fix deposit) start with no contact
   grow_arrays(atom->nmax);
   atom->add_callback(Atom::GROW);
+  atom->add_callback(Atom::RESTART);
   for (int i = 0; i < atom->nlocal; ++i) set_arrays(i);
 }
 
 FixRecords::~FixRecords() {
   atom->delete_callback(id, Atom::GROW);
+  atom->delete_callback(id, Atom::RESTART);
   memory->destroy(rec_);
+}
+
+// Restart files: per atom, the count n + 1 and then the n = slots * width values (LAMMPS's layout for
+// per-atom fix data: unpack_restart skips the earlier fixes' blocks by their leading counts). A
+// restart read back with the same fix ID and style (the pair style's records fix is created with its
+// fixed ID at the first run after read_restart; the wall fix takes the ID the input gives it again)
+// gets its records back in Modify::add_fix.
+int FixRecords::pack_restart(int i, double* buf) {
+  const int n = slots_ * width_;
+  buf[0] = n + 1;
+  std::memcpy(buf + 1, rec_[i], sizeof(double) * n);
+  return n + 1;
+}
+
+void FixRecords::unpack_restart(int nlocal, int nth) {
+  double** extra = atom->extra;
+  int m = 0;
+  for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[nlocal][m]);
+  const int n = static_cast<int>(extra[nlocal][m]) - 1;
+  if (n != slots_ * width_)
+    fail_one(lmp, std::string("fix ") + id + ": the restart file's records have " + std::to_string(n) +
+                      " values per atom, this fix " + std::to_string(slots_ * width_));
+  std::memcpy(rec_[nlocal], &extra[nlocal][m + 1], sizeof(double) * n);
+}
+
+int FixRecords::size_restart(int) { return slots_ * width_ + 1; }
+int FixRecords::maxsize_restart() { return slots_ * width_ + 1; }
+
+void FixRecords::post_run() {
+  if (summary_draw_) summary(lmp, summary_who_, *summary_draw_, summary_pair_);
 }
 
 void FixRecords::grow_arrays(int nmax) { memory->grow(rec_, nmax, slots_ * width_, "asperity/records:rec"); }
@@ -236,6 +316,7 @@ double FixRecords::memory_usage() { return static_cast<double>(atom->nmax) * slo
 
 PairHooke::PairHooke(LAMMPS* lmp) : Pair(lmp) {
   single_enable = 0;
+  restartinfo = 0;  // give pair_style and pair_coeff again after read_restart; the contact records are in the file
   no_virial_fdotr_compute = 1;
   finitecutflag = 1;
   records_id_ = "ASPERITY_PAIR_RECORDS";
@@ -252,6 +333,7 @@ PairHooke::~PairHooke() {
 void PairHooke::settings(int narg, char** arg) {
   if (narg < 4) fail(lmp, "pair_style asperity/hooke kn kt gammat xmu table FILE [constant EPS|none] seed S ...");
   read_contact_numbers(lmp, arg, &kn_, &kt_, &gammat_, &xmu_);
+  draw_.reset();  // settings given again for the same style: start from none
   std::string why;
   for (int i = 4; i < narg;) {
     const int used = draw_.keyword(narg, arg, i, why);
@@ -268,13 +350,17 @@ void PairHooke::coeff(int narg, char** arg) {
     const int n = atom->ntypes;
     memory->create(setflag, n + 1, n + 1, "pair:setflag");
     memory->create(cutsq, n + 1, n + 1, "pair:cutsq");
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) setflag[i][j] = 0;
     allocated = 1;
   }
   int ilo, ihi, jlo, jhi;
   utils::bounds(FLERR, arg[0], 1, atom->ntypes, ilo, ihi, error);
   utils::bounds(FLERR, arg[1], 1, atom->ntypes, jlo, jhi, error);
-  for (int i = 1; i <= atom->ntypes; ++i)
-    for (int j = 1; j <= atom->ntypes; ++j) setflag[i][j] = (i >= ilo && i <= ihi && j >= jlo && j <= jhi) ? 1 : 0;
+  int count = 0;
+  for (int i = ilo; i <= ihi; ++i)
+    for (int j = std::max(jlo, i); j <= jhi; ++j) setflag[i][j] = 1, ++count;
+  if (count == 0) fail(lmp, "pair_coeff for asperity/hooke: no type pair in " + std::string(arg[0]) + " " + arg[1]);
 }
 
 void PairHooke::init_style() {
@@ -285,15 +371,35 @@ void PairHooke::init_style() {
   if (modify->find_fix(records_id_) < 0)
     modify->add_fix(records_id_ + " all asperity/records " + std::to_string(kSlots) + " " + std::to_string(WIDTH));
   records_ = static_cast<FixRecords*>(modify->fix[modify->find_fix(records_id_)]);
-  double rmax = 0.0;
-  for (int i = 0; i < atom->nlocal; ++i) rmax = std::fmax(rmax, atom->radius[i]);
-  MPI_Allreduce(&rmax, &cut_, 1, MPI_DOUBLE, MPI_MAX, world);
-  cut_ *= 2.0;
-  if (!(cut_ > 0.0)) fail(lmp, "pair_style asperity/hooke: no atom with a radius > 0");
+  records_->set_summary(&draw_, "pair_style asperity/hooke", true);
+  speed_si_ = speed_unit_si(lmp, "pair_style asperity/hooke");
+  // The largest radius per type, of the atoms present and of those that fix pour and fix deposit will
+  // insert (their extract("radius", type), as gran/hooke/history does): the cutoff of a type pair is
+  // the sum of the two, so that poured atoms meet their contacts before they overlap.
+  const int nt = atom->ntypes;
+  std::vector<double> mine(nt + 1, 0.0);
+  for (int f = 0; f < modify->nfix; ++f) {
+    const std::string style = modify->fix[f]->style;
+    if (style != "pour" && style != "deposit") continue;
+    for (int t = 1; t <= nt; ++t) {
+      int type = t;  // extract() may change it
+      const void* r = modify->fix[f]->extract("radius", type);
+      if (r) mine[t] = std::fmax(mine[t], *static_cast<const double*>(r));
+    }
+  }
+  for (int i = 0; i < atom->nlocal; ++i) mine[atom->type[i]] = std::fmax(mine[atom->type[i]], atom->radius[i]);
+  rmax_.assign(nt + 1, 0.0);
+  MPI_Allreduce(mine.data(), rmax_.data(), nt + 1, MPI_DOUBLE, MPI_MAX, world);
+  if (!(*std::max_element(rmax_.begin(), rmax_.end()) > 0.0))
+    fail(lmp, "pair_style asperity/hooke: no atom with a radius > 0, and no fix pour or fix deposit to insert one");
   neighbor->request(this, instance_me);
 }
 
-double PairHooke::init_one(int, int) { return cut_; }
+double PairHooke::init_one(int i, int j) {
+  const double cut = rmax_[i] + rmax_[j];
+  // a type pair with no atom of either type yet: the largest cutoff (LAMMPS needs one > 0)
+  return cut > 0.0 ? cut : 2.0 * *std::max_element(rmax_.begin(), rmax_.end());
+}
 
 // An atom's active records are kept at the front of its slots (forget_ended compacts them), so a
 // search stops at the first free slot: one or two comparisons for a particle with one contact.
@@ -364,14 +470,22 @@ void PairHooke::compute(int eflag, int vflag) {
       double* rj = j < nlocal ? find_or_add(j, tag[i], fresh_j) : nullptr;
       if (fresh_i) {
         // First touch: the approach speed now selects the table's row; one draw for the contact.
-        const double vn = -(c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2]) / c.r;
+        const double vn = -speed_si_ * (c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2]) / c.r;
         const std::uint64_t a = static_cast<std::uint64_t>(tag[i] < tag[j] ? tag[i] : tag[j]);
         const std::uint64_t b = static_cast<std::uint64_t>(tag[i] < tag[j] ? tag[j] : tag[i]);
         const double u = contact_uniform(draw_.seed(), a, b, step, ContactKind::pair);
+        Flag flag;
         ri[START] = static_cast<double>(step);
-        ri[EPS] = draw_.eps(vn, u);
+        ri[EPS] = draw_.eps(vn, u, flag);
         ri[GAMMA] = draw_.gamma(ri[EPS], kn_, c.meff);
-        if (j < nlocal || tag[i] < tag[j]) draw_.log(step, ContactKind::pair, a, b, vn, u, ri[EPS], ri[GAMMA]);
+        if (j < nlocal || tag[i] < tag[j]) {  // once per contact, on one rank
+          draw_.log(step, ContactKind::pair, a, b, vn, u, ri[EPS], ri[GAMMA], flag);
+          draw_.counts().n[static_cast<int>(flag)] += 1;
+          if (j >= nlocal) draw_.counts().remote += 1;
+          if (draw_.refuse_outside() && (flag == Flag::below || flag == Flag::above))
+            fail_one(lmp, "pair_style asperity/hooke: atoms " + std::to_string(a) + " and " + std::to_string(b) +
+                              " meet at " + std::to_string(vn) + " m/s, outside the table's speeds (outside error)");
+        }
       }
       p.gamma = ri[GAMMA];
       double fij[3], fs[3];
@@ -423,11 +537,15 @@ FixWall::FixWall(LAMMPS* lmp, int narg, char** arg) : FixRecords(lmp, 3, arg, 1,
     i += used;
   }
   if (!draw_.finish(comm->me, why)) fail(lmp, "fix asperity/wall/hooke: " + why);
+  set_summary(&draw_, std::string("fix ") + id + " asperity/wall/hooke", false);
 }
 
 int FixWall::setmask() { return LAMMPS_NS::FixConst::POST_FORCE; }
 
-void FixWall::init() { require_sphere(lmp, "fix asperity/wall/hooke"); }
+void FixWall::init() {
+  require_sphere(lmp, "fix asperity/wall/hooke");
+  speed_si_ = speed_unit_si(lmp, "fix asperity/wall/hooke");
+}
 
 void FixWall::setup(int vflag) { post_force(vflag); }
 
@@ -452,13 +570,18 @@ void FixWall::post_force(int) {
     for (int d = 0; d < 3; ++d) c.vr[d] = v[i][d], c.wr[d] = radius[i] * omega[i][d] / dz;
     c.meff = rmass[i];  // the wall's mass is infinite
     if (rec[ACTIVE] == 0.0) {
-      const double vn = -v[i][2];
+      const double vn = -speed_si_ * v[i][2];
       const double u = contact_uniform(draw_.seed(), static_cast<std::uint64_t>(tag[i]), wall_, step, ContactKind::wall);
+      Flag flag;
       rec[ACTIVE] = 1.0;
       rec[START] = static_cast<double>(step);
-      rec[EPS] = draw_.eps(vn, u);
+      rec[EPS] = draw_.eps(vn, u, flag);
       rec[GAMMA] = draw_.gamma(rec[EPS], kn_, c.meff);
-      draw_.log(step, ContactKind::wall, static_cast<std::uint64_t>(tag[i]), wall_, vn, u, rec[EPS], rec[GAMMA]);
+      draw_.log(step, ContactKind::wall, static_cast<std::uint64_t>(tag[i]), wall_, vn, u, rec[EPS], rec[GAMMA], flag);
+      draw_.counts().n[static_cast<int>(flag)] += 1;
+      if (draw_.refuse_outside() && (flag == Flag::below || flag == Flag::above))
+        fail_one(lmp, "fix asperity/wall/hooke: atom " + std::to_string(tag[i]) + " meets the wall at " +
+                          std::to_string(vn) + " m/s, outside the table's speeds (outside error)");
     }
     p.gamma = rec[GAMMA];
     double fw[3], fs[3];

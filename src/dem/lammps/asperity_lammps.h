@@ -12,6 +12,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "fix.h"
 #include "pair.h"
@@ -32,7 +33,14 @@ class FixRecords : public LAMMPS_NS::Fix {
   void set_arrays(int i) override;
   int pack_exchange(int i, double* buf) override;
   int unpack_exchange(int nlocal, double* buf) override;
+  int pack_restart(int i, double* buf) override;
+  void unpack_restart(int nlocal, int nth) override;
+  int size_restart(int nlocal) override;
+  int maxsize_restart() override;
+  void post_run() override;
   double memory_usage() override;
+  /// Whose end-of-run summary this fix prints (the pair style's draw, or the wall's own).
+  void set_summary(Draw* draw, const std::string& who, bool pair) { summary_draw_ = draw, summary_who_ = who, summary_pair_ = pair; }
 
   double* record(int i, int slot) { return rec_[i] + slot * width_; }
   int slots() const { return slots_; }
@@ -43,6 +51,9 @@ class FixRecords : public LAMMPS_NS::Fix {
   void allocate();
   int slots_ = 0, width_ = 0;
   double** rec_ = nullptr;
+  Draw* summary_draw_ = nullptr;
+  std::string summary_who_;
+  bool summary_pair_ = false;
 };
 
 /// pair_style asperity/hooke kn kt gammat xmu table FILE [constant EPS|none] seed S [scale_damping X] [log FILE]
@@ -62,7 +73,9 @@ class PairHooke : public LAMMPS_NS::Pair {
   static constexpr int kSlots = 16;
   double* find_or_add(int i, LAMMPS_NS::tagint partner, bool& fresh);
   void forget_ended();
-  double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0, cut_ = 0;
+  double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0;
+  double speed_si_ = 1.0;         // the input's velocity unit in m/s
+  std::vector<double> rmax_;      // per type: the largest radius present or to be inserted
   Draw draw_;
   FixRecords* records_ = nullptr;
   std::string records_id_;
@@ -82,6 +95,7 @@ class FixWall : public FixRecords {
   // The atom's wall record: in contact (0/1), start step, eps, gamma_n, shear[3].
   enum { ACTIVE, START, EPS, GAMMA, SHEAR, WIDTH = SHEAR + 3 };
   double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0, zlo_ = 0;
+  double speed_si_ = 1.0;
   std::uint64_t wall_ = 1;
   Draw draw_;
 };
