@@ -75,7 +75,7 @@ std::vector<Contact> read_log(const std::string& path) {
 }
 
 struct Atom {
-  int type;  // 1: started on the left, moving +x; 2: on the right
+  int type;  // 2: started on the right, moving -x; any other (1, 3): on the left
   double vx;
 };
 
@@ -185,9 +185,9 @@ int headon(const Cdf& cdf, double top, const std::string& log, const std::string
   for (const auto& c : contacts) {
     const auto i = vx.find(c.a), j = vx.find(c.b);
     if (i == vx.end() || j == vx.end()) throw std::runtime_error("contact of an atom missing from the dump");
-    if (i->second.type == j->second.type) throw std::runtime_error("a contact between two atoms of one side");
+    if ((i->second.type == 2) == (j->second.type == 2)) throw std::runtime_error("a contact between two atoms of one side");
     // after the collision the right sphere (type 2) moves +x relative to the left one
-    const double sign = i->second.type == 1 ? 1.0 : -1.0;
+    const double sign = i->second.type != 2 ? 1.0 : -1.0;
     const double achieved = sign * (j->second.vx - i->second.vx) / speed;
     bias += achieved - c.eps;
     bias2 += (achieved - c.eps) * (achieved - c.eps);

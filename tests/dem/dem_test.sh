@@ -28,25 +28,25 @@ case $case_ in
     # one-speed table at 0.62 m/s (between the rows 0.6031 and 0.6614; its own seed) for dem.headon
     rm -rf "$work/table"
     "$vg" -q --no-plots --scene "$ex/rough-sphere.toml" --out "$work/table"
-    # (10^6 drops, 2001 probabilities: its own sampling noise well below the table's)
+    # (4x10^5 drops, 2001 probabilities: its own sampling noise well below the table's)
     sed -e 's/^speeds = \[.*/speeds = [0.62]/' -e 's/^file = .*/file = "ref-0.62.csv"/' -e 's/^seed = 7/seed = 8/' \
-      -e 's/^name = .*/name = "ref-0.62"/' -e 's/^drops = 100000/drops = 1000000/' -e 's/^probabilities = 501/probabilities = 2001/' \
+      -e 's/^name = .*/name = "ref-0.62"/' -e 's/^drops = 100000/drops = 400000/' -e 's/^probabilities = 501/probabilities = 2001/' \
       "$ex/rough-sphere.toml" > "$work/ref-0.62.toml"
-    grep -q '^speeds = \[0.62\]' "$work/ref-0.62.toml" && grep -q '^seed = 8' "$work/ref-0.62.toml" && grep -q '^drops = 1000000' "$work/ref-0.62.toml"
+    grep -q '^speeds = \[0.62\]' "$work/ref-0.62.toml" && grep -q '^seed = 8' "$work/ref-0.62.toml" && grep -q '^drops = 400000' "$work/ref-0.62.toml"
     "$vg" -q --no-plots --scene "$work/ref-0.62.toml" --out "$work/table"
     head -1 "$table" "$work/table/ref-0.62.csv" ;;
   headon)  # 10^4 head-on collisions at 0.62 m/s, between two rows of the table they draw from, checked
     # against the independent one-speed table at 0.62 m/s, read by dem_check's own parser
     fresh headon
     lammps "$ex/two-spheres.in" -var table "$table" -var pairs 10000 -var speed 0.62
-    "$check" headon_ref "$work/table/ref-0.62.csv" contacts.log final.dump 0.62 accept 100000 1000000
+    "$check" headon_ref "$work/table/ref-0.62.csv" contacts.log final.dump 0.62 accept 100000 400000
     # a wrong input it must refuse: the reference at another speed than the run's
-    if "$check" headon_ref "$work/table/ref-0.62.csv" contacts.log final.dump 1.0 accept 100000 1000000; then
+    if "$check" headon_ref "$work/table/ref-0.62.csv" contacts.log final.dump 1.0 accept 100000 400000; then
       echo "headon: a reference at 0.62 m/s was accepted for a run at 1 m/s"; exit 1
     fi ;;
-  wrong_damping)  # the same with every gamma_n 1 % too large: must be rejected
+  wrong_damping)  # every gamma_n 1 % too large, 4000 pairs at 1 m/s: must be rejected
     fresh wrong_damping
-    lammps "$ex/two-spheres.in" -var table "$table" -var pairs 10000 -var scale 1.01
+    lammps "$ex/two-spheres.in" -var table "$table" -var pairs 4000 -var scale 1.01
     "$check" headon "$table" contacts.log final.dump 1.0 reject ;;
   bounce)  # 225 balls x 50 impacts on the plate: residuals ~ Eq. 2 at the Sec. V rates
     fresh bounce
@@ -161,6 +161,18 @@ case $case_ in
     if "$lmp" -log none -in bad.in -var table "$table" -var log none > out.txt 2>&1; then echo "outside maybe accepted"; exit 1; fi
     grep -F "outside 'maybe': clamp or error" out.txt
     echo "outside: 20 contacts at 3 m/s flagged above, 20 at 0.03 m/s below; outside error refuses" ;;
+  types)  # two type pairs, two tables (pair_coeff 2 3 table B): each follows its own; B = 1 - 1.5 (1 - eps) of the table
+    fresh types
+    awk -F, 'BEGIN {OFS = ","} /^[0-9]/ {for (k = 2; k <= NF; ++k) $k = sprintf("%.12g", 1 - 1.5 * (1 - $k))} {print}' "$table" > b.csv
+    lammps "$ex/two-spheres.in" -var table "$table" -var pairs 4000 -var types 1 -var table2 b.csv
+    # split the contacts by the type of their left sphere (1: table, 3: b.csv)
+    sed -n '/ITEM: ATOMS/,$p' final.dump | tail -n +2 | awk '{print $1, $2}' > types.txt
+    awk 'FNR == NR {t[$1] = $2; next} /^#/ {next} {print > ((t[$3] == 3 || t[$4] == 3) ? "b.log" : "a.log")}' types.txt contacts.log
+    echo "types: $(wc -l < a.log) contacts of type pair 1 2, $(wc -l < b.log) of 2 3"
+    "$check" headon "$table" a.log final.dump 1.0 accept
+    "$check" headon b.csv b.log final.dump 1.0 accept
+    # the wrong input it must reject: type pair 1 2 checked against the other table
+    "$check" headon b.csv a.log final.dump 1.0 reject ;;
   install)  # cmake --install --component dem: the program, its examples and command pages; the installed example runs
     fresh install
     build=$(dirname "$(dirname "$(dirname "$lmp")")")
@@ -225,10 +237,12 @@ case $case_ in
     grep -Eq "^table - constant: -?[0-9]+ instructions per contact" ir.out ;;
   examples)  # the commands of docs/dem-coupling.md, as written there (in a copy of examples/dem)
     fresh examples
-    cp "$ex"/two-spheres.in "$ex"/bouncing-ball.in "$table" .
+    cp "$ex"/two-spheres.in "$ex"/bouncing-ball.in "$ex"/pour.in "$table" .
     "$lmp" -in two-spheres.in -var table rough-sphere.csv
     "$lmp" -in bouncing-ball.in -var table rough-sphere.csv
+    "$lmp" -in pour.in -var table rough-sphere.csv
     test "$(grep -c pair contacts.log)" = 1 && test "$(grep -c wall impacts.log)" = 50
-    echo "examples: 1 pair contact, 50 impacts" ;;
+    test "$(sed -n '/ITEM: ATOMS/,$p' final.dump | tail -n +2 | wc -l)" = 60
+    echo "examples: 1 pair contact, 50 impacts, 60 spheres poured" ;;
   *) echo "unknown case $case_" >&2; exit 2 ;;
 esac

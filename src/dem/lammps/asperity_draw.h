@@ -49,6 +49,19 @@ struct Counts {
   double remote = 0;  // pair contacts whose partner atom is owned by another rank
 };
 
+/// Where a type pair's eps comes from when pair_coeff gives it its own: a table, or one constant.
+struct Source {
+  Source() = default;
+  Source(const Source&) = delete;
+  Source& operator=(const Source&) = delete;
+  ~Source() {
+    if (have_table) asperity_cor_free(&table);
+  }
+  asperity_cor_table table{};
+  bool have_table = false;
+  double constant = -1.0;
+};
+
 /// The settings shared by pair_style asperity/hooke and fix asperity/wall/hooke: the source of eps
 /// (a table, or one constant eps for comparisons), the stream's seed, a damping factor for tests
 /// (1 = the header's conversion), what to do with speeds outside the table, and an optional
@@ -80,20 +93,25 @@ class Draw {
   /// eps of a contact that begins now, at normal approach speed vn [m/s] (clamped to the table's
   /// speeds by the header), and the uniform that drew it; `flag` says how (see Flag). A contact
   /// with vn <= 0 gets the fallback eps.
-  double eps(double vn, double u, Flag& flag) const {
+  double eps(double vn, double u, Flag& flag) const { return eps_from(have_table_ ? &table_ : nullptr, constant_, vn, u, flag); }
+  /// The same from a type pair's own source (pair_coeff I J table FILE | constant EPS).
+  static double eps_from(const asperity_cor_table* t, double constant, double vn, double u, Flag& flag) {
     if (!(vn > 0.0)) {
       flag = Flag::separating;
-      return fallback();
+      return fallback_from(t, constant);
     }
-    if (!have_table_) {
+    if (!t) {
       flag = Flag::in;
-      return constant_;
+      return constant;
     }
-    flag = vn < table_.speeds[0] ? Flag::below : (vn > table_.speeds[table_.n_speeds - 1] ? Flag::above : Flag::in);
-    return asperity_cor_sample(&table_, vn, u);
+    flag = vn < t->speeds[0] ? Flag::below : (vn > t->speeds[t->n_speeds - 1] ? Flag::above : Flag::in);
+    return asperity_cor_sample(t, vn, u);
   }
   /// The eps of a contact that is no impact: the `constant`, else the median of the lowest row.
-  double fallback() const { return have_table_ ? asperity_cor_sample(&table_, table_.speeds[0], 0.5) : constant_; }
+  double fallback() const { return fallback_from(have_table_ ? &table_ : nullptr, constant_); }
+  static double fallback_from(const asperity_cor_table* t, double constant) {
+    return t ? asperity_cor_sample(t, t->speeds[0], 0.5) : constant;
+  }
   /// 'outside error': a speed outside the table is an error, not a clamp.
   bool refuse_outside() const { return refuse_outside_; }
   const asperity_cor_table* table() const { return have_table_ ? &table_ : nullptr; }
@@ -105,6 +123,7 @@ class Draw {
     return damping_scale_ * asperity_cor_linear_gamma(e, k, m_eff);
   }
   std::uint64_t seed() const { return seed_; }
+  bool has_seed() const { return have_seed_; }
   /// One line per contact, written when it begins (nothing without `log`).
   void log(std::int64_t step, ContactKind kind, std::uint64_t a, std::uint64_t b, double vn, double u, double eps,
            double gamma, Flag flag) const {

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "atom.h"
@@ -344,22 +345,53 @@ void PairHooke::settings(int narg, char** arg) {
   if (!draw_.finish(comm->me, why)) fail(lmp, "pair_style asperity/hooke: " + why);
 }
 
+// pair_coeff I J                     the style's table (or constant)
+// pair_coeff I J table FILE          this type pair draws from its own table (cortable: the same)
+// pair_coeff I J constant EPS        this type pair has one eps
 void PairHooke::coeff(int narg, char** arg) {
-  if (narg != 2) fail(lmp, "pair_coeff for asperity/hooke takes no values: pair_coeff * *");
+  if (narg != 2 && narg != 4)
+    fail(lmp, "pair_coeff I J [table FILE | cortable FILE | constant EPS] for asperity/hooke");
+  const int n = atom->ntypes;
   if (!allocated) {
-    const int n = atom->ntypes;
     memory->create(setflag, n + 1, n + 1, "pair:setflag");
     memory->create(cutsq, n + 1, n + 1, "pair:cutsq");
     for (int i = 0; i <= n; ++i)
       for (int j = 0; j <= n; ++j) setflag[i][j] = 0;
+    source_of_.assign(static_cast<std::size_t>((n + 1) * (n + 1)), -1);
     allocated = 1;
   }
   int ilo, ihi, jlo, jhi;
-  utils::bounds(FLERR, arg[0], 1, atom->ntypes, ilo, ihi, error);
-  utils::bounds(FLERR, arg[1], 1, atom->ntypes, jlo, jhi, error);
+  utils::bounds(FLERR, arg[0], 1, n, ilo, ihi, error);
+  utils::bounds(FLERR, arg[1], 1, n, jlo, jhi, error);
+  int source = -1;  // the style's own
+  if (narg == 4) {
+    const std::string k = arg[2];
+    auto src = std::make_unique<Source>();
+    if (k == "table" || k == "cortable") {
+      char err[512];
+      if (asperity_cor_load(&src->table, arg[3], err, sizeof err) != 0)
+        fail(lmp, std::string("pair_coeff ") + arg[0] + " " + arg[1] + " asperity/hooke: table: " + err);
+      src->have_table = true;
+      if (!draw_.has_seed()) fail(lmp, "pair_coeff ... table needs 'seed S' in pair_style asperity/hooke");
+    } else if (k == "constant") {
+      char* end = nullptr;
+      const double x = std::strtod(arg[3], &end);
+      if (!*arg[3] || *end || !(x >= 0.0 && x <= 1.0))
+        fail(lmp, std::string("pair_coeff asperity/hooke: constant '") + arg[3] + "': eps must lie in [0, 1]");
+      src->constant = x;
+    } else {
+      fail(lmp, "pair_coeff asperity/hooke: unknown keyword '" + k + "' (table, cortable or constant)");
+    }
+    sources_.push_back(std::move(src));
+    source = static_cast<int>(sources_.size()) - 1;
+  }
   int count = 0;
   for (int i = ilo; i <= ihi; ++i)
-    for (int j = std::max(jlo, i); j <= jhi; ++j) setflag[i][j] = 1, ++count;
+    for (int j = std::max(jlo, i); j <= jhi; ++j) {
+      setflag[i][j] = 1, ++count;
+      source_of_[static_cast<std::size_t>(i * (n + 1) + j)] = source;
+      source_of_[static_cast<std::size_t>(j * (n + 1) + i)] = source;
+    }
   if (count == 0) fail(lmp, "pair_coeff for asperity/hooke: no type pair in " + std::string(arg[0]) + " " + arg[1]);
 }
 
@@ -445,6 +477,7 @@ void PairHooke::compute(int eflag, int vflag) {
   double **x = atom->x, **v = atom->v, **f = atom->f, **omega = atom->omega, **torque = atom->torque;
   const double *radius = atom->radius, *rmass = atom->rmass;
   const tagint* tag = atom->tag;
+  const int* type = atom->type;
   const int nlocal = atom->nlocal;
   const bigint step = update->ntimestep;
   Params p{kn_, 0.0, kt_, gammat_, xmu_, update->dt, update->setupflag == 0};
@@ -476,7 +509,13 @@ void PairHooke::compute(int eflag, int vflag) {
         const double u = contact_uniform(draw_.seed(), a, b, step, ContactKind::pair);
         Flag flag;
         ri[START] = static_cast<double>(step);
-        ri[EPS] = draw_.eps(vn, u, flag);
+        const int src = source_of_[static_cast<std::size_t>(type[i] * (atom->ntypes + 1) + type[j])];
+        if (src < 0) {
+          ri[EPS] = draw_.eps(vn, u, flag);
+        } else {
+          const Source& so = *sources_[static_cast<std::size_t>(src)];
+          ri[EPS] = Draw::eps_from(so.have_table ? &so.table : nullptr, so.constant, vn, u, flag);
+        }
         ri[GAMMA] = draw_.gamma(ri[EPS], kn_, c.meff);
         if (j < nlocal || tag[i] < tag[j]) {  // once per contact, on one rank
           draw_.log(step, ContactKind::pair, a, b, vn, u, ri[EPS], ri[GAMMA], flag);

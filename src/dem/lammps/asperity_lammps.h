@@ -11,6 +11,7 @@
 // loader does (Debian's LAMMPS has no PLUGIN package). docs/dem-coupling.md has the syntax.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,8 @@ class PairHooke : public LAMMPS_NS::Pair {
   double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0;
   double speed_si_ = 1.0;         // the input's velocity unit in m/s
   std::vector<double> rmax_;      // per type: the largest radius present or to be inserted
+  std::vector<int> source_of_;    // per type pair (i * (ntypes + 1) + j): index into sources_, -1 = the style's
+  std::vector<std::unique_ptr<Source>> sources_;
   Draw draw_;
   FixRecords* records_ = nullptr;
   std::string records_id_;
