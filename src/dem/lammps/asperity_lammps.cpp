@@ -145,7 +145,7 @@ struct Params {
 // Normal: kn overlap - gamma_n d(delta)/dt along del; tangential: spring kt on the shear history plus
 // the dashpot meff gammat, capped by Coulomb xmu |F_n| (the history rescaled to the cap).
 // Returns the normal approach speed; writes the force on i (f) and its tangential part (fs).
-void hooke(const Contact& c, const Params& p, double* shear, double* f, double* fs) {
+inline __attribute__((always_inline)) void hooke(const Contact& c, const Params& p, double* shear, double* f, double* fs) {
   const double rinv = 1.0 / c.r, rsqinv = rinv * rinv;
   const double vnnr = c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2];
   double vtr[3];
@@ -454,9 +454,15 @@ double* PairHooke::find_or_add(int i, tagint partner, bool& fresh) {
                     std::to_string(kSlots) + " contacts");
 }
 
+// Drops the records of contacts not touched in this step (they ended), keeping the active ones at the
+// front. Fast path: touched_[i] counts the distinct records of i touched in this step; when the slot
+// after them is free, they are all of i's records (active records are contiguous from slot 0), and
+// nothing ended.
 void PairHooke::forget_ended() {
   const double now = static_cast<double>(update->ntimestep);
   for (int i = 0; i < atom->nlocal; ++i) {
+    const int k = touched_[i];
+    if (k < kSlots && records_->record(i, k)[PARTNER] == 0.0) continue;  // all touched (or none active)
     int n = 0;
     while (n < kSlots && records_->record(i, n)[PARTNER] != 0.0) ++n;
     for (int s = 0; s < n;) {
@@ -481,10 +487,22 @@ void PairHooke::compute(int eflag, int vflag) {
   const int nlocal = atom->nlocal;
   const bigint step = update->ntimestep;
   Params p{kn_, 0.0, kt_, gammat_, xmu_, update->dt, update->setupflag == 0};
+  // Slot hints, one pair per neighbour-list entry (the slot of the contact in i's and in j's records the
+  // last time it was found), rebuilt with the list; a hint is used only after its record's partner id
+  // has been checked, so a stale one (records compacted by forget_ended) costs one search, no error.
+  if (update->setupflag || neighbor->lastcall != hints_step_ || hint_first_.size() != static_cast<std::size_t>(list->inum) + 1) {
+    hints_step_ = neighbor->lastcall;
+    hint_first_.assign(static_cast<std::size_t>(list->inum) + 1, 0);
+    for (int ii = 0; ii < list->inum; ++ii) hint_first_[ii + 1] = hint_first_[ii] + list->numneigh[list->ilist[ii]];
+    hints_.assign(2 * static_cast<std::size_t>(hint_first_.back()), 0);
+  }
+  const double now = static_cast<double>(step);
+  touched_.assign(static_cast<std::size_t>(nlocal), 0);
   for (int ii = 0; ii < list->inum; ++ii) {
     const int i = list->ilist[ii];
     const int* jlist = list->firstneigh[i];
-    for (int jj = 0; jj < list->numneigh[i]; ++jj) {
+    unsigned char* hint = hints_.data() + 2 * static_cast<std::size_t>(hint_first_[ii]);
+    for (int jj = 0; jj < list->numneigh[i]; ++jj, hint += 2) {
       const int j = jlist[jj] & NEIGHMASK;
       Contact c;
       for (int d = 0; d < 3; ++d) c.del[d] = x[i][d] - x[j][d];
@@ -492,15 +510,21 @@ void PairHooke::compute(int eflag, int vflag) {
       const double radsum = radius[i] + radius[j];
       if (rsq >= radsum * radsum) continue;  // not touching: its records are dropped below
       c.r = std::sqrt(rsq);
+      const double rinv = 1.0 / c.r;
       c.overlap = radsum - c.r;
       for (int d = 0; d < 3; ++d) {
         c.vr[d] = v[i][d] - v[j][d];
-        c.wr[d] = (radius[i] * omega[i][d] + radius[j] * omega[j][d]) / c.r;
+        c.wr[d] = (radius[i] * omega[i][d] + radius[j] * omega[j][d]) * rinv;
       }
       c.meff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
       bool fresh_i = false, fresh_j = false;
-      double* ri = find_or_add(i, tag[j], fresh_i);
-      double* rj = j < nlocal ? find_or_add(j, tag[i], fresh_j) : nullptr;
+      double* ri = records_->record(i, hint[0]);
+      if (ri[PARTNER] != static_cast<double>(tag[j])) ri = find_or_add(i, tag[j], fresh_i), hint[0] = slot_of(i, ri);
+      double* rj = nullptr;
+      if (j < nlocal) {
+        rj = records_->record(j, hint[1]);
+        if (rj[PARTNER] != static_cast<double>(tag[i])) rj = find_or_add(j, tag[i], fresh_j), hint[1] = slot_of(j, rj);
+      }
       if (fresh_i) {
         // First touch: the approach speed now selects the table's row; one draw for the contact.
         const double vn = -speed_si_ * (c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2]) / c.r;
@@ -529,9 +553,10 @@ void PairHooke::compute(int eflag, int vflag) {
       p.gamma = ri[GAMMA];
       double fij[3], fs[3];
       hooke(c, p, ri + SHEAR, fij, fs);
-      ri[TOUCHED] = static_cast<double>(step);
-      const double tor[3] = {(c.del[1] * fs[2] - c.del[2] * fs[1]) / c.r, (c.del[2] * fs[0] - c.del[0] * fs[2]) / c.r,
-                             (c.del[0] * fs[1] - c.del[1] * fs[0]) / c.r};
+      touched_[i] += ri[TOUCHED] != now;
+      ri[TOUCHED] = now;
+      const double tor[3] = {(c.del[1] * fs[2] - c.del[2] * fs[1]) * rinv, (c.del[2] * fs[0] - c.del[0] * fs[2]) * rinv,
+                             (c.del[0] * fs[1] - c.del[1] * fs[0]) * rinv};
       for (int d = 0; d < 3; ++d) {
         f[i][d] += fij[d];
         torque[i][d] -= radius[i] * tor[d];
@@ -544,7 +569,8 @@ void PairHooke::compute(int eflag, int vflag) {
           f[j][d] -= fij[d];
           torque[j][d] -= radius[j] * tor[d];
         }
-        rj[TOUCHED] = static_cast<double>(step);
+        touched_[j] += rj[TOUCHED] != now;
+        rj[TOUCHED] = now;
       }
       if (evflag) ev_tally_xyz(i, j, nlocal, 0, 0.0, 0.0, fij[0], fij[1], fij[2], c.del[0], c.del[1], c.del[2]);
     }

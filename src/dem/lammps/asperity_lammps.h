@@ -73,10 +73,17 @@ class PairHooke : public LAMMPS_NS::Pair {
   enum { PARTNER, START, EPS, GAMMA, SHEAR, TOUCHED = SHEAR + 3, WIDTH };
   static constexpr int kSlots = 16;
   double* find_or_add(int i, LAMMPS_NS::tagint partner, bool& fresh);
+  unsigned char slot_of(int i, const double* r) const {
+    return static_cast<unsigned char>((r - records_->record(i, 0)) / WIDTH);
+  }
   void forget_ended();
   double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0;
   double speed_si_ = 1.0;         // the input's velocity unit in m/s
   std::vector<double> rmax_;      // per type: the largest radius present or to be inserted
+  LAMMPS_NS::bigint hints_step_ = -1;
+  std::vector<int> hint_first_;          // per ilist position: its first neighbour entry
+  std::vector<unsigned char> hints_;     // per neighbour entry: slot in i's records, slot in j's
+  std::vector<int> touched_;             // per local atom: its distinct records touched in this step
   std::vector<int> source_of_;    // per type pair (i * (ntypes + 1) + j): index into sources_, -1 = the style's
   std::vector<std::unique_ptr<Source>> sources_;
   Draw draw_;
