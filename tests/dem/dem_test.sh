@@ -173,6 +173,15 @@ case $case_ in
     "$check" headon b.csv b.log final.dump 1.0 accept
     # the wrong input it must reject: type pair 1 2 checked against the other table
     "$check" headon b.csv a.log final.dump 1.0 reject ;;
+  crowd)  # one sphere with 40 contacts (records start with 16 slots): runs, equals gran/hooke/history with one eps
+    fresh crowd
+    lammps "$src/tests/dem/crowd.in" -var table "$table" -var log crowd.log -var out asperity.dump
+    lammps "$src/tests/dem/crowd.in" -var native 1 -var out native.dump
+    test "$(grep -c '^0 pair 1 ' crowd.log)" = 40
+    paste <(sed -n '/ITEM: ATOMS/,$p' asperity.dump | tail -n +2) <(sed -n '/ITEM: ATOMS/,$p' native.dump | tail -n +2) |
+      awk '$1 != $5 {print "atom order differs"; exit 1}
+           {for (k = 2; k <= 4; ++k) {d = $k - $(k + 4); d = d < 0 ? -d : d; m = d > m ? d : m}; if ($1 == 1) v = $2 * $2 + $3 * $3 + $4 * $4}
+           END {printf "crowd: 40 contacts on atom 1; max |v(asperity) - v(gran/hooke/history)| = %.3g m/s (bound 1e-12)\n", m; exit !(NR == 41 && m < 1e-12)}' ;;
   install)  # cmake --install --component dem: the program, its examples and command pages; the installed example runs
     fresh install
     build=$(dirname "$(dirname "$(dirname "$lmp")")")

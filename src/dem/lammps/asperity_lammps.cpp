@@ -248,7 +248,8 @@ FixRecords::FixRecords(LAMMPS* lmp, int narg, char** arg, int slots, int width)
 }
 
 void FixRecords::allocate() {
-  maxexchange = slots_ * width_;
+  maxexchange = slots_ * width_ + 1;
+  maxexchange_dynamic = 1;  // the slots grow when an atom needs more (grow_slots): comm asks again
   restart_peratom = 1;   // the records go into restart files (pack_restart) and come back (unpack_restart)
   create_attribute = 1;  // atoms created during a run (fix pour, fix deposit) start with no contact
   grow_arrays(atom->nmax);
@@ -263,31 +264,74 @@ FixRecords::~FixRecords() {
   memory->destroy(rec_);
 }
 
-// Restart files: per atom, the count n + 1 and then the n = slots * width values (LAMMPS's layout for
-// per-atom fix data: unpack_restart skips the earlier fixes' blocks by their leading counts). A
-// restart read back with the same fix ID and style (the pair style's records fix is created with its
-// fixed ID at the first run after read_restart; the wall fix takes the ID the input gives it again)
-// gets its records back in Modify::add_fix.
+// The active records of atom i: those at the front whose first value is nonzero (free records are 0).
+int FixRecords::active(int i) const {
+  int n = 0;
+  while (n < slots_ && rec_[i][n * width_] != 0.0) ++n;
+  return n;
+}
+
+// More slots for every atom of this rank (at least `need`, at least twice as many): the records
+// stay, the new slots are free. Pointers into the records are invalid afterwards.
+void FixRecords::grow_slots(int need) {
+  const int slots = std::max(need, 2 * slots_);
+  double** grown = nullptr;
+  memory->create(grown, std::max(atom->nmax, 1), slots * width_, "asperity/records:rec");
+  for (int i = 0; i < atom->nmax; ++i) {
+    std::memcpy(grown[i], rec_[i], sizeof(double) * slots_ * width_);
+    std::memset(grown[i] + slots_ * width_, 0, sizeof(double) * (slots - slots_) * width_);
+  }
+  memory->destroy(rec_);
+  rec_ = grown;
+  slots_ = slots;
+  maxexchange = slots_ * width_ + 1;
+}
+
+// Migration (Comm::exchange) and restart files carry the active records only, after their count, so
+// ranks whose slots have grown differently exchange atoms and read each other's restart files.
+int FixRecords::pack_exchange(int i, double* buf) {
+  const int n = active(i);
+  buf[0] = n;
+  std::memcpy(buf + 1, rec_[i], sizeof(double) * n * width_);
+  return 1 + n * width_;
+}
+
+int FixRecords::unpack_exchange(int nlocal, double* buf) {
+  const int n = static_cast<int>(buf[0]);
+  if (n > slots_) grow_slots(n);
+  std::memset(rec_[nlocal], 0, sizeof(double) * slots_ * width_);
+  std::memcpy(rec_[nlocal], buf + 1, sizeof(double) * n * width_);
+  return 1 + n * width_;
+}
+
+// Restart files: per atom, the block's length (LAMMPS's layout for per-atom fix data: unpack_restart
+// skips the earlier fixes' blocks by their leading lengths), the count n of active records, and
+// their n * width values. A restart read back with the same fix ID and style (the pair style's
+// records fix is created with its fixed ID at the first run after read_restart; the wall fix takes
+// the ID the input gives it again) gets its records back in Modify::add_fix.
 int FixRecords::pack_restart(int i, double* buf) {
-  const int n = slots_ * width_;
-  buf[0] = n + 1;
-  std::memcpy(buf + 1, rec_[i], sizeof(double) * n);
-  return n + 1;
+  const int n = active(i);
+  buf[0] = 2 + n * width_;
+  buf[1] = n;
+  std::memcpy(buf + 2, rec_[i], sizeof(double) * n * width_);
+  return 2 + n * width_;
 }
 
 void FixRecords::unpack_restart(int nlocal, int nth) {
   double** extra = atom->extra;
   int m = 0;
   for (int k = 0; k < nth; ++k) m += static_cast<int>(extra[nlocal][m]);
-  const int n = static_cast<int>(extra[nlocal][m]) - 1;
-  if (n != slots_ * width_)
-    fail_one(lmp, std::string("fix ") + id + ": the restart file's records have " + std::to_string(n) +
-                      " values per atom, this fix " + std::to_string(slots_ * width_));
-  std::memcpy(rec_[nlocal], &extra[nlocal][m + 1], sizeof(double) * n);
+  const int len = static_cast<int>(extra[nlocal][m]), n = static_cast<int>(extra[nlocal][m + 1]);
+  if (n < 0 || len != 2 + n * width_)
+    fail_one(lmp, std::string("fix ") + id + ": the restart file's records do not have " + std::to_string(width_) +
+                      " values each (written by another version of the style?)");
+  if (n > slots_) grow_slots(n);
+  std::memset(rec_[nlocal], 0, sizeof(double) * slots_ * width_);
+  std::memcpy(rec_[nlocal], &extra[nlocal][m + 2], sizeof(double) * n * width_);
 }
 
-int FixRecords::size_restart(int) { return slots_ * width_ + 1; }
-int FixRecords::maxsize_restart() { return slots_ * width_ + 1; }
+int FixRecords::size_restart(int i) { return 2 + active(i) * width_; }
+int FixRecords::maxsize_restart() { return 2 + slots_ * width_; }
 
 void FixRecords::post_run() {
   if (summary_draw_) summary(lmp, summary_who_, *summary_draw_, summary_pair_);
@@ -300,16 +344,6 @@ void FixRecords::copy_arrays(int i, int j, int /*delflag*/) {
 }
 
 void FixRecords::set_arrays(int i) { std::memset(rec_[i], 0, sizeof(double) * slots_ * width_); }
-
-int FixRecords::pack_exchange(int i, double* buf) {
-  std::memcpy(buf, rec_[i], sizeof(double) * slots_ * width_);
-  return slots_ * width_;
-}
-
-int FixRecords::unpack_exchange(int nlocal, double* buf) {
-  std::memcpy(rec_[nlocal], buf, sizeof(double) * slots_ * width_);
-  return slots_ * width_;
-}
 
 double FixRecords::memory_usage() { return static_cast<double>(atom->nmax) * slots_ * width_ * sizeof(double); }
 
@@ -401,7 +435,7 @@ void PairHooke::init_style() {
   // Every rank keeps both sides' records of a pair it sees and integrates them itself: newton off.
   if (force->newton_pair) fail(lmp, "pair_style asperity/hooke needs 'newton off'");
   if (modify->find_fix(records_id_) < 0)
-    modify->add_fix(records_id_ + " all asperity/records " + std::to_string(kSlots) + " " + std::to_string(WIDTH));
+    modify->add_fix(records_id_ + " all asperity/records " + std::to_string(kSlots0) + " " + std::to_string(WIDTH));
   records_ = static_cast<FixRecords*>(modify->fix[modify->find_fix(records_id_)]);
   records_->set_summary(&draw_, "pair_style asperity/hooke", true);
   speed_si_ = speed_unit_si(lmp, "pair_style asperity/hooke");
@@ -437,7 +471,8 @@ double PairHooke::init_one(int i, int j) {
 // search stops at the first free slot: one or two comparisons for a particle with one contact.
 double* PairHooke::find_or_add(int i, tagint partner, bool& fresh) {
   const double key = static_cast<double>(partner);
-  for (int s = 0; s < kSlots; ++s) {
+  const int slots = records_->slots();
+  for (int s = 0; s < slots; ++s) {
     double* r = records_->record(i, s);
     if (r[PARTNER] == key) {
       fresh = false;
@@ -450,8 +485,13 @@ double* PairHooke::find_or_add(int i, tagint partner, bool& fresh) {
       return r;
     }
   }
-  fail_one(lmp, "pair_style asperity/hooke: atom " + std::to_string(atom->tag[i]) + " has more than " +
-                    std::to_string(kSlots) + " contacts");
+  // every slot of i is in use: more slots for all atoms (no fixed cap; pointers into records move)
+  if (slots >= 65535) fail_one(lmp, "pair_style asperity/hooke: atom " + std::to_string(atom->tag[i]) + " has 65535 contacts");
+  records_->grow_slots(slots + 1);
+  double* r = records_->record(i, slots);
+  r[PARTNER] = key;
+  fresh = true;
+  return r;
 }
 
 // Drops the records of contacts not touched in this step (they ended), keeping the active ones at the
@@ -460,11 +500,12 @@ double* PairHooke::find_or_add(int i, tagint partner, bool& fresh) {
 // nothing ended.
 void PairHooke::forget_ended() {
   const double now = static_cast<double>(update->ntimestep);
+  const int slots = records_->slots();
   for (int i = 0; i < atom->nlocal; ++i) {
     const int k = touched_[i];
-    if (k < kSlots && records_->record(i, k)[PARTNER] == 0.0) continue;  // all touched (or none active)
+    if (k < slots && records_->record(i, k)[PARTNER] == 0.0) continue;  // all touched (or none active)
     int n = 0;
-    while (n < kSlots && records_->record(i, n)[PARTNER] != 0.0) ++n;
+    while (n < slots && records_->record(i, n)[PARTNER] != 0.0) ++n;
     for (int s = 0; s < n;) {
       double* r = records_->record(i, s);
       if (r[TOUCHED] == now) {
@@ -501,7 +542,7 @@ void PairHooke::compute(int eflag, int vflag) {
   for (int ii = 0; ii < list->inum; ++ii) {
     const int i = list->ilist[ii];
     const int* jlist = list->firstneigh[i];
-    unsigned char* hint = hints_.data() + 2 * static_cast<std::size_t>(hint_first_[ii]);
+    std::uint16_t* hint = hints_.data() + 2 * static_cast<std::size_t>(hint_first_[ii]);
     for (int jj = 0; jj < list->numneigh[i]; ++jj, hint += 2) {
       const int j = jlist[jj] & NEIGHMASK;
       Contact c;
@@ -518,13 +559,15 @@ void PairHooke::compute(int eflag, int vflag) {
       }
       c.meff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
       bool fresh_i = false, fresh_j = false;
-      double* ri = records_->record(i, hint[0]);
-      if (ri[PARTNER] != static_cast<double>(tag[j])) ri = find_or_add(i, tag[j], fresh_i), hint[0] = slot_of(i, ri);
+      if (hint[0] >= records_->slots() || records_->record(i, hint[0])[PARTNER] != static_cast<double>(tag[j]))
+        hint[0] = slot_of(i, find_or_add(i, tag[j], fresh_i));
       double* rj = nullptr;
       if (j < nlocal) {
+        if (hint[1] >= records_->slots() || records_->record(j, hint[1])[PARTNER] != static_cast<double>(tag[i]))
+          hint[1] = slot_of(j, find_or_add(j, tag[i], fresh_j));
         rj = records_->record(j, hint[1]);
-        if (rj[PARTNER] != static_cast<double>(tag[i])) rj = find_or_add(j, tag[i], fresh_j), hint[1] = slot_of(j, rj);
       }
+      double* ri = records_->record(i, hint[0]);  // after j's search, which may have grown the slots
       if (fresh_i) {
         // First touch: the approach speed now selects the table's row; one draw for the contact.
         const double vn = -speed_si_ * (c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2]) / c.r;

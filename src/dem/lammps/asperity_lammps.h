@@ -44,6 +44,8 @@ class FixRecords : public LAMMPS_NS::Fix {
   void set_summary(Draw* draw, const std::string& who, bool pair) { summary_draw_ = draw, summary_who_ = who, summary_pair_ = pair; }
 
   double* record(int i, int slot) { return rec_[i] + slot * width_; }
+  int active(int i) const;
+  void grow_slots(int need);
   int slots() const { return slots_; }
   int width() const { return width_; }
 
@@ -71,10 +73,10 @@ class PairHooke : public LAMMPS_NS::Pair {
  private:
   // A pair record: partner id (0: free), start step, eps, gamma_n, shear[3], last step touched.
   enum { PARTNER, START, EPS, GAMMA, SHEAR, TOUCHED = SHEAR + 3, WIDTH };
-  static constexpr int kSlots = 16;
+  static constexpr int kSlots0 = 16;  // slots per atom at first; grown (doubled) when an atom needs more
   double* find_or_add(int i, LAMMPS_NS::tagint partner, bool& fresh);
-  unsigned char slot_of(int i, const double* r) const {
-    return static_cast<unsigned char>((r - records_->record(i, 0)) / WIDTH);
+  std::uint16_t slot_of(int i, const double* r) const {
+    return static_cast<std::uint16_t>((r - records_->record(i, 0)) / WIDTH);
   }
   void forget_ended();
   double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0;
@@ -82,7 +84,7 @@ class PairHooke : public LAMMPS_NS::Pair {
   std::vector<double> rmax_;      // per type: the largest radius present or to be inserted
   LAMMPS_NS::bigint hints_step_ = -1;
   std::vector<int> hint_first_;          // per ilist position: its first neighbour entry
-  std::vector<unsigned char> hints_;     // per neighbour entry: slot in i's records, slot in j's
+  std::vector<std::uint16_t> hints_;     // per neighbour entry: slot in i's records, slot in j's
   std::vector<int> touched_;             // per local atom: its distinct records touched in this step
   std::vector<int> source_of_;    // per type pair (i * (ntypes + 1) + j): index into sources_, -1 = the style's
   std::vector<std::unique_ptr<Source>> sources_;
