@@ -182,6 +182,23 @@ case $case_ in
       awk '$1 != $5 {print "atom order differs"; exit 1}
            {for (k = 2; k <= 4; ++k) {d = $k - $(k + 4); d = d < 0 ? -d : d; m = d > m ? d : m}; if ($1 == 1) v = $2 * $2 + $3 * $3 + $4 * $4}
            END {printf "crowd: 40 contacts on atom 1; max |v(asperity) - v(gran/hooke/history)| = %.3g m/s (bound 1e-12)\n", m; exit !(NR == 41 && m < 1e-12)}' ;;
+  walls)  # fix asperity/wall/hooke with one eps equals fix wall/gran hooke/history, plane and zcylinder (oblique, spin, friction)
+    fresh walls
+    for wall in zplane zcylinder; do
+      lammps "$src/tests/dem/walls.in" -var wall $wall && mv final.dump asperity.dump
+      grep -F "fix w asperity/wall/hooke: 9 contacts begun in this run, eps 0.9 (constant) for each" lammps.log
+      lammps "$src/tests/dem/walls.in" -var wall $wall -var native 1 && mv final.dump native.dump
+      paste <(sed -n '/ITEM: ATOMS/,$p' asperity.dump | tail -n +2) <(sed -n '/ITEM: ATOMS/,$p' native.dump | tail -n +2) |
+        awk -v w=$wall '$1 != $8 {print "atom order differs"; exit 1}
+             {for (k = 2; k <= 4; ++k) {d = $k - $(k + 7); d = d < 0 ? -d : d; m = d > m ? d : m; s += $k * $k}
+              for (k = 5; k <= 7; ++k) {d = ($k - $(k + 7)) * 3e-3; d = d < 0 ? -d : d; m = d > m ? d : m}}
+             END {printf "walls: %s, 9 spheres: max |v - v(wall/gran)| and R |omega - omega(wall/gran)| = %.3g m/s (bound 1e-12)\n", w, m
+                  exit !(NR == 9 && m < 1e-12 && s > 0)}'
+    done
+    # a wrong input it must refuse
+    sed 's/${wall} ${wallarg} constant/zcylinder -0.02 constant/' "$src/tests/dem/walls.in" > bad.in
+    if "$lmp" -log none -in bad.in -var wall zcylinder > out.txt 2>&1; then echo "a negative cylinder radius was accepted"; exit 1; fi
+    grep -F "zcylinder radius '-0.02' must be > 0" out.txt ;;
   install)  # cmake --install --component dem: the program, its examples and command pages; the installed example runs
     fresh install
     build=$(dirname "$(dirname "$(dirname "$lmp")")")

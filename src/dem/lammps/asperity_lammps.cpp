@@ -218,6 +218,10 @@ void summary(LAMMPS* lmp, const std::string& who, Draw& draw, bool pair) {
   if (lmp->comm->me != 0) return;
   char line[640];
   const asperity_cor_table* t = draw.table();
+  if (!t)
+    std::snprintf(line, sizeof line, "%s: %.0f contacts begun in this run, eps %.6g (constant) for each%s", who.c_str(), begun,
+                  draw.fallback(), pair ? "" : "\n");
+  else
   std::snprintf(line, sizeof line,
                 "%s: %.0f contacts begun in this run: %.0f within the table's speeds, %.0f below them (drawn from "
                 "the %g m/s row), %.0f above them (drawn from the %g m/s row), %.0f first seen separating (no impact: "
@@ -559,15 +563,21 @@ void PairHooke::compute(int eflag, int vflag) {
       }
       c.meff = rmass[i] * rmass[j] / (rmass[i] + rmass[j]);
       bool fresh_i = false, fresh_j = false;
-      if (hint[0] >= records_->slots() || records_->record(i, hint[0])[PARTNER] != static_cast<double>(tag[j]))
-        hint[0] = slot_of(i, find_or_add(i, tag[j], fresh_i));
+      // (a hint is always < the slots: it comes from slot_of, and the slots only grow)
+      double* ri = records_->record(i, hint[0]);
+      if (ri[PARTNER] != static_cast<double>(tag[j])) {
+        ri = find_or_add(i, tag[j], fresh_i);
+        hint[0] = slot_of(i, ri);
+      }
       double* rj = nullptr;
       if (j < nlocal) {
-        if (hint[1] >= records_->slots() || records_->record(j, hint[1])[PARTNER] != static_cast<double>(tag[i]))
-          hint[1] = slot_of(j, find_or_add(j, tag[i], fresh_j));
         rj = records_->record(j, hint[1]);
+        if (rj[PARTNER] != static_cast<double>(tag[i])) {
+          rj = find_or_add(j, tag[i], fresh_j);
+          hint[1] = slot_of(j, rj);
+          ri = records_->record(i, hint[0]);  // j's search may have grown the slots (and moved i's records)
+        }
       }
-      double* ri = records_->record(i, hint[0]);  // after j's search, which may have grown the slots
       if (fresh_i) {
         // First touch: the approach speed now selects the table's row; one draw for the contact.
         const double vn = -speed_si_ * (c.vr[0] * c.del[0] + c.vr[1] * c.del[1] + c.vr[2] * c.del[2]) / c.r;
@@ -626,11 +636,13 @@ void PairHooke::compute(int eflag, int vflag) {
 
 FixWall::FixWall(LAMMPS* lmp, int narg, char** arg) : FixRecords(lmp, 3, arg, 1, WIDTH) {
   // fix ID group asperity/wall/hooke kn kt gammat xmu zplane zlo table FILE [constant EPS|none] seed S [wall N] ...
-  if (narg < 9 || std::strcmp(arg[7], "zplane") != 0)
-    fail(lmp, "fix asperity/wall/hooke kn kt gammat xmu zplane ZLO table FILE [constant EPS|none] seed S "
+  if (narg < 9 || (std::strcmp(arg[7], "zplane") != 0 && std::strcmp(arg[7], "zcylinder") != 0))
+    fail(lmp, "fix asperity/wall/hooke kn kt gammat xmu zplane ZLO|zcylinder RADIUS table FILE [constant EPS|none] seed S "
                       "[wall N] [scale_damping X] [log FILE]");
   read_contact_numbers(lmp, arg + 3, &kn_, &kt_, &gammat_, &xmu_);
-  zlo_ = utils::numeric(FLERR, arg[8], false, lmp);
+  cylinder_ = std::strcmp(arg[7], "zcylinder") == 0;
+  zlo_ = utils::numeric(FLERR, arg[8], false, lmp);  // zplane: the plane z = zlo; zcylinder: the radius about the z axis
+  if (cylinder_ && !(zlo_ > 0.0)) fail(lmp, std::string("fix asperity/wall/hooke: zcylinder radius '") + arg[8] + "' must be > 0");
   std::string why;
   for (int i = 9; i < narg;) {
     if (std::strcmp(arg[i], "wall") == 0) {
@@ -666,19 +678,29 @@ void FixWall::post_force(int) {
   Params p{kn_, 0.0, kt_, gammat_, xmu_, update->dt, update->setupflag == 0};
   for (int i = 0; i < atom->nlocal; ++i) {
     double* rec = record(i, 0);
-    const double dz = x[i][2] - zlo_;
-    if (!(mask[i] & groupbit) || dz >= radius[i] || dz <= 0.0) {
+    // the distance from the wall, and del = x_i - the wall's nearest point: the plane below the
+    // particle, or the cylinder about the z axis around it (the particle inside)
+    Contact c;
+    double dist;
+    if (cylinder_) {
+      const double rxy = std::sqrt(x[i][0] * x[i][0] + x[i][1] * x[i][1]);
+      dist = zlo_ - rxy;
+      const double s = rxy > 0.0 ? -dist / rxy : 0.0;
+      c.del[0] = s * x[i][0], c.del[1] = s * x[i][1], c.del[2] = 0.0;
+    } else {
+      dist = x[i][2] - zlo_;
+      c.del[0] = c.del[1] = 0.0, c.del[2] = dist;
+    }
+    if (!(mask[i] & groupbit) || dist >= radius[i] || dist <= 0.0) {
       std::memset(rec, 0, sizeof(double) * WIDTH);  // not touching (or through the wall): no contact
       continue;
     }
-    Contact c;
-    c.del[0] = c.del[1] = 0.0, c.del[2] = dz;
-    c.r = dz;
-    c.overlap = radius[i] - dz;
-    for (int d = 0; d < 3; ++d) c.vr[d] = v[i][d], c.wr[d] = radius[i] * omega[i][d] / dz;
+    c.r = dist;
+    c.overlap = radius[i] - dist;
+    for (int d = 0; d < 3; ++d) c.vr[d] = v[i][d], c.wr[d] = radius[i] * omega[i][d] / dist;
     c.meff = rmass[i];  // the wall's mass is infinite
     if (rec[ACTIVE] == 0.0) {
-      const double vn = -speed_si_ * v[i][2];
+      const double vn = -speed_si_ * (v[i][0] * c.del[0] + v[i][1] * c.del[1] + v[i][2] * c.del[2]) / dist;
       const double u = contact_uniform(draw_.seed(), static_cast<std::uint64_t>(tag[i]), wall_, step, ContactKind::wall);
       Flag flag;
       rec[ACTIVE] = 1.0;

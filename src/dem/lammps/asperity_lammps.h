@@ -93,7 +93,7 @@ class PairHooke : public LAMMPS_NS::Pair {
   std::string records_id_;
 };
 
-/// fix ID group asperity/wall/hooke kn kt gammat xmu zplane zlo table FILE [constant EPS|none] seed S
+/// fix ID group asperity/wall/hooke kn kt gammat xmu zplane zlo|zcylinder radius table FILE [constant EPS|none] seed S
 ///     [wall N] [scale_damping X] [log FILE]
 class FixWall : public FixRecords {
  public:
@@ -107,6 +107,7 @@ class FixWall : public FixRecords {
   // The atom's wall record: in contact (0/1), start step, eps, gamma_n, shear[3].
   enum { ACTIVE, START, EPS, GAMMA, SHEAR, WIDTH = SHEAR + 3 };
   double kn_ = 0, kt_ = 0, gammat_ = 0, xmu_ = 0, zlo_ = 0;
+  bool cylinder_ = false;
   double speed_si_ = 1.0;
   std::uint64_t wall_ = 1;
   Draw draw_;
