@@ -252,15 +252,18 @@ case $case_ in
     awk '$1 ~ /^(table|constant|native)$/ && NF == 3 {n++; if (!($2 > 0 && $3 > 0)) bad++}
          END {exit !(n == 9 && bad == 0)}' cost.out || { echo "bench: 9 positive loop and Pair times expected"; exit 1; }
     ;;
-  bench_ir)  # the callgrind script of docs/dem-coupling.md section 5, at 2 and 4 pairs (~1-2 min)
+  bench_ir)  # the dense-packing callgrind script of docs/dem-coupling.md section 5 at 32 atoms, 10 steps (one
+    # valgrind run, ~10 s of CPU; bench/dem_lammps_instructions.sh, six runs, is left to the bench itself)
     if ! command -v valgrind > /dev/null; then
-      echo "SKIPPED: valgrind is not installed (bench/dem_lammps_instructions.sh needs callgrind)"
+      echo "SKIPPED: valgrind is not installed (bench/dem_fcc_instructions.sh needs callgrind)"
       exit 77
     fi
     fresh bench_ir
     build=$(dirname "$(dirname "$(dirname "$lmp")")")
-    "$src/bench/dem_lammps_instructions.sh" "$build" "$table" 2 | tee ir.out
-    grep -Eq "^table - constant: -?[0-9]+ instructions per contact" ir.out ;;
+    "$src/bench/dem_fcc_instructions.sh" "$build" 2 10 | tee ir.out
+    grep -Eq "^dem_fcc: 32 atoms, 10 steps: asperity/hooke [0-9]+, gran/hooke/history [0-9]+ instructions per atom-step; ratio [0-9.]+$" ir.out
+    # the two styles ran the same dynamics: equal final kinetic energies (to 1e-12 relative)
+    awk '/final kinetic energy/ {a = $6; b = $8; sub(",", "", a); d = (a - b) / b; exit !(d * d < 1e-24)}' ir.out ;;
   examples)  # the commands of docs/dem-coupling.md, as written there (in a copy of examples/dem)
     fresh examples
     cp "$ex"/two-spheres.in "$ex"/bouncing-ball.in "$ex"/pour.in "$table" .
