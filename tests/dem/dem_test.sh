@@ -132,7 +132,11 @@ case $case_ in
                    d = sqrt(dx * dx + dy * dy + (z[i] - z[j]) ^ 2); o = (r[i] + r[j] - d) / (r[i] + r[j]); if (o > worst) worst = o}}
                printf "pour: %d atoms (%d expected), deepest overlap %.3g of the radius sum (bound 0.05)\n", NR, want, worst
                exit !(NR == want && worst < 0.05)}'
-    done ;;
+    done
+    # the wrong input it must refuse: an empty box with nothing to insert atoms (no radius to size the cutoff)
+    grep -v '^fix pour' "$ex/pour.in" > nopour.in
+    if "$lmp" -log none -in nopour.in -var table "$table" > out.txt 2>&1; then echo "an empty box without fix pour was accepted"; exit 1; fi
+    grep -F "no atom with a radius > 0, and no fix pour or fix deposit to insert one" out.txt ;;
   hybrid)  # pair_style hybrid (asperity/hooke for type pair 1 2, zero elsewhere) gives the plain style's run
     fresh hybrid
     lammps "$ex/two-spheres.in" -var table "$table" -var pairs 100 -var log plain.log -var out plain.dump
@@ -181,7 +185,12 @@ case $case_ in
     paste <(sed -n '/ITEM: ATOMS/,$p' asperity.dump | tail -n +2) <(sed -n '/ITEM: ATOMS/,$p' native.dump | tail -n +2) |
       awk '$1 != $5 {print "atom order differs"; exit 1}
            {for (k = 2; k <= 4; ++k) {d = $k - $(k + 4); d = d < 0 ? -d : d; m = d > m ? d : m}; if ($1 == 1) v = $2 * $2 + $3 * $3 + $4 * $4}
-           END {printf "crowd: 40 contacts on atom 1; max |v(asperity) - v(gran/hooke/history)| = %.3g m/s (bound 1e-12)\n", m; exit !(NR == 41 && m < 1e-12)}' ;;
+           END {printf "crowd: 40 contacts on atom 1; max |v(asperity) - v(gran/hooke/history)| = %.3g m/s (bound 1e-12)\n", m; exit !(NR == 41 && m < 1e-12)}'
+    # the comparison can fail: gran/hooke/history with another eps (0.8) must differ by more than 1e-6 m/s
+    lammps "$src/tests/dem/crowd.in" -var native 1 -var constant 0.8 -var out other.dump
+    paste <(sed -n '/ITEM: ATOMS/,$p' asperity.dump | tail -n +2) <(sed -n '/ITEM: ATOMS/,$p' other.dump | tail -n +2) |
+      awk '{for (k = 2; k <= 4; ++k) {d = $k - $(k + 4); d = d < 0 ? -d : d; m = d > m ? d : m}}
+           END {printf "crowd: against eps 0.8 instead: max |dv| = %.3g m/s (must exceed 1e-6)\n", m; exit !(m > 1e-6)}' ;;
   walls)  # fix asperity/wall/hooke with one eps equals fix wall/gran hooke/history, plane and zcylinder (oblique, spin, friction)
     fresh walls
     for wall in zplane zcylinder; do
@@ -247,8 +256,11 @@ case $case_ in
     build=$(dirname "$(dirname "$(dirname "$lmp")")")
     "$src/bench/dem_lammps_cost.sh" "$build" "$table" 20 3 | tee cost.out
     grep -q "^per contact (1000 steps each): table - constant" cost.out
-    # no time it prints may be negative (a difference of two noisy walls is reported as below the spread)
-    if grep -Eq '(^|[ (:=])-[0-9.]+ ?(s|us)\b' cost.out; then echo "bench: a negative time was printed"; exit 1; fi
+    # no time it prints may be negative (a difference of two noisy walls is reported as below the spread);
+    # the pattern catches the line the script printed before this check (a wrong input it must reject)
+    neg='(^|[ (:=])-[0-9.]+ ?(s|us)\b'
+    echo "per contact (1000 steps each): table - constant -861.92 us of loop time" | grep -Eq "$neg"
+    if grep -Eq "$neg" cost.out; then echo "bench: a negative time was printed"; exit 1; fi
     awk '$1 ~ /^(table|constant|native)$/ && NF == 3 {n++; if (!($2 > 0 && $3 > 0)) bad++}
          END {exit !(n == 9 && bad == 0)}' cost.out || { echo "bench: 9 positive loop and Pair times expected"; exit 1; }
     ;;
