@@ -705,11 +705,25 @@ Law eq28_printed(const ImpactScene& s) {
   // (At Omega = 0 the exponent is ~ -3e9 + O(1): its rounding makes q noisy at ~3e-7 relative,
   // which limits the agreement of the two rules to ~3e-8. That is the floor of the literal formula
   // in double precision, far below the 1e-6 required.)
-  if (P->Z != 0 && std::abs(P->Zcoarse / P->Z - 1.0) > 1e-6)
-    d << "; WARNING: quadrature not converged (relative change " << num(std::abs(P->Zcoarse / P->Z - 1.0), 2)
-      << " between 128 and 256 panels)";
+  // Where the signed spike's raw integral cancels (Omega_x = 1 rad/s at fig4's sphere: h + f Omega_x
+  // = h + f vanishes at the spike's centre and the raw integral passes through 0, -8.7 at 0.99 and
+  // +8.5 at 1.01), there is no normalised law: the two rules disagree, and the cdf and pdf throw
+  // (a report skips the law, naming why) instead of dividing by rounding noise.
+  const bool unresolved = P->Z != 0 && std::abs(P->Zcoarse / P->Z - 1.0) > 1e-6;
+  if (unresolved)
+    d << "; UNDEFINED: the raw integral cancels to rounding (relative change " << num(std::abs(P->Zcoarse / P->Z - 1.0), 2)
+      << " between 128 and 256 panels), so the printed pdf cannot be normalised";
   d << "; " << scene_text(x);
   law.description = d.str();
+  if (unresolved) {
+    const std::string why = "eq28_printed: the printed pdf's raw integral cancels at Omega_x = " + num(s.omega_x, 17) +
+                            " rad/s (relative change " + num(std::abs(P->Zcoarse / P->Z - 1.0), 2) +
+                            " between 128 and 256 panels): no normalised law";
+    law.cdf = [why](double) -> double { throw std::domain_error(why); };
+    law.pdf = [why](double) -> double { throw std::domain_error(why); };
+    law.mean = std::numeric_limits<double>::quiet_NaN();
+    return law;
+  }
   law.cdf = [P](double t) { return P->cdf(t); };
   law.pdf = [P](double t) { return P->pdf(t); };
   law.mean = mean;

@@ -524,6 +524,21 @@ TEST(TheoryImpact, PrintedEq28AtSmallSpin) {
   EXPECT_EQ(scaled_raw(1e-80), "-6.12239e+80");
   EXPECT_EQ(scaled_raw(-1e-300), "6.122e300");  // -raw(|w|) to leading order; log form past 1e300
   EXPECT_EQ(scaled_raw(5e-324).substr(0, 8), "-1.239e3");
+  // Omega_x = 1 rad/s: h + f Omega_x vanishes at the spike's centre and the raw integral passes
+  // through 0 (-8.68 at 0.99, +8.51 at 1.01): there the law is undefined and says so (its cdf
+  // throws: a report skips it) instead of a mean of 157 from rounding noise (3dfd20f: 91.9).
+  ImpactScene one = fig4();
+  one.omega_x = 1.0;
+  const Law undefined = eq28_printed(one);
+  EXPECT_THROW((void)undefined.cdf(0.5), std::domain_error);
+  EXPECT_TRUE(std::isnan(undefined.mean));
+  EXPECT_NE(undefined.description.find("UNDEFINED"), std::string::npos) << undefined.description;
+  for (double w : {0.99, 1.01}) {
+    one.omega_x = w;
+    const Law l = eq28_printed(one);
+    EXPECT_NEAR(l.mean, -1.00204, 1e-4) << w;
+    EXPECT_EQ(l.cdf(0.5), 1.0) << w;
+  }
 }
 
 TEST(TheoryImpact, PrintedEq28IsNotADensity) {
