@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-3.0-or-later
 # Marginal instructions per drop by phase between two callgrind runs that differ only in the number
 # of spheres (bench/RESULTS.md, "Drop engine, issue 30"): inclusive cost of each phase's function in
 # run B minus run A, divided by the drops B has more. Usage: callgrind_phases.py A.out B.out DROPS.

@@ -11,7 +11,15 @@ come from Debian (scripts/setup --python).
   (ninja then rebuilds only what changed); only the module's target and the libraries it links
   are built.
 - Progress: pip shows a build's output only with `-v`, so the compiler's progress lines (ninja's
-  `[done/total]`) also go to the terminal (/dev/tty) when there is one.
+  `[done/total]`) and this backend's own lines also go to the terminal (/dev/tty) when there is
+  one, and otherwise (a CI job, a notebook's `!pip install .`, `pip install . 2>&1 | tee log`,
+  `>> log`) to pip's own standard error (the parent process's, when it is a pipe, a device or a
+  file opened for appending), which pip does not capture. Every line of the
+  build also goes to `asperity-pip.log` in the build directory.
+- Python: the floor is pyproject.toml's `requires-python` (3.9). pyproject.toml is read with
+  tomllib where there is one (3.11+); before 3.11 with a reader for the [project] table's simple
+  forms (strings, arrays, inline tables), which tests/python/test_pep517_backend.py checks
+  against tomllib.
 - The wheel: CMake installs the component `python-wheel` (module, __init__.py, the stubs,
   py.typed and the asperity shared libraries) into a staging directory. A wheel cannot hold a
   symbolic link, and the loader asks for each library by its SONAME (libasperity_core.so.1), so
@@ -24,6 +32,7 @@ import io
 import os
 import re
 import shutil
+import stat
 import subprocess
 import sys
 import sysconfig
@@ -44,13 +53,48 @@ def _version():
     return m.group(1)
 
 
+def _project_table(text):
+    """The [project] table of pyproject.toml without tomllib (Python < 3.11): `key = value` lines
+    whose values are basic strings, arrays and inline tables of them (a value may span lines until
+    its brackets close). Anything else raises, naming the line."""
+    import ast
+    out, inside, pending, start = {}, False, "", 0
+    for no, line in enumerate(text.splitlines(), 1):
+        stripped = line.strip()
+        if not pending:
+            if stripped.startswith("["):
+                inside = stripped == "[project]"
+                continue
+            if not inside or not stripped or stripped.startswith("#"):
+                continue
+            start = no
+        pending += line + "\n"
+        body = re.sub(r'"(?:[^"\\]|\\.)*"', '""', pending)  # brackets inside strings do not count
+        body = re.sub(r"#.*", "", body)
+        if body.count("[") + body.count("{") > body.count("]") + body.count("}"):
+            continue
+        key, sep, value = pending.partition("=")
+        pending = ""
+        key = key.strip().strip('"')
+        if not sep or not re.fullmatch(r"[A-Za-z0-9_-]+", key):
+            raise RuntimeError(f"pyproject.toml:{start}: not a `key = value` line this reader knows")
+        value = "\n".join(re.sub(r'^((?:[^"#]|"(?:[^"\\]|\\.)*")*)#.*$', r"\1", v) for v in value.splitlines())
+        value = re.sub(r'([{,]\s*)([A-Za-z0-9_-]+)\s*=', r'\1"\2":', value)  # inline tables: k = v -> "k": v
+        try:
+            out[key] = ast.literal_eval(value.strip())
+        except (ValueError, SyntaxError) as e:
+            raise RuntimeError(f"pyproject.toml:{start}: {key}: a value this reader cannot read ({e})") from e
+    return out
+
+
 def _project():
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        data = f.read()
     try:
         import tomllib
-    except ModuleNotFoundError as e:  # Python < 3.11
-        raise RuntimeError("asperity's build backend reads pyproject.toml with tomllib (Python >= 3.11)") from e
-    with open(ROOT / "pyproject.toml", "rb") as f:
-        return tomllib.load(f)["project"]
+    except ModuleNotFoundError:  # Python < 3.11: pyproject.toml's requires-python is 3.9
+        return _project_table(data.decode("utf-8"))
+    return tomllib.loads(data.decode("utf-8"))["project"]
 
 
 def _metadata():
@@ -83,27 +127,89 @@ def _say(msg):
     print(f"asperity build: {msg}", file=sys.stderr, flush=True)
 
 
-def _terminal():
-    """The user's terminal, where pip does not swallow the progress; None without one."""
+def _same_file(a, b):
+    return (a.st_dev, a.st_ino) == (b.st_dev, b.st_ino)
+
+
+def _progress_sink():
+    """Where the progress lines go, as pip swallows this process's output: the user's terminal,
+    or, without one, pip's own standard error (the parent's; Linux /proc), unless that is where
+    this process's output goes anyway. None when neither can be opened."""
     try:
         return open("/dev/tty", "w", encoding="utf-8", errors="replace")
     except OSError:
+        pass
+    ppid = os.getppid()
+    parent = f"/proc/{ppid}/fd/2"
+    try:
+        st = os.stat(parent)
+        if _same_file(st, os.fstat(sys.stdout.fileno())):
+            return None
+        if stat.S_ISREG(st.st_mode):
+            # A file opened without O_APPEND (`> log`): pip writes at its own offset, over lines
+            # added at the end; only an appending one (`>> log`) can be shared.
+            with open(f"/proc/{ppid}/fdinfo/2", encoding="ascii") as info:
+                flags = next((int(line.split()[1], 8) for line in info if line.startswith("flags:")), 0)
+            if not flags & os.O_APPEND:
+                return None
+        elif not (stat.S_ISFIFO(st.st_mode) or stat.S_ISCHR(st.st_mode)):
+            return None
+        return open(parent, "a", encoding="utf-8", errors="replace")
+    except (OSError, ValueError, io.UnsupportedOperation):
         return None
 
 
-def _run(args, tty):
-    line = "cmake " + " ".join(str(a) for a in args)
-    _say(line)
-    if tty:
-        print(f"asperity build: {line}", file=tty, flush=True)
-    proc = subprocess.Popen(["cmake", *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True, errors="replace")
-    for out in proc.stdout:
+class _Output:
+    """The build's output: every line to this process's stdout (pip -v) and the build directory's
+    asperity-pip.log; the progress lines also to the sink."""
+
+    def __init__(self, log_path):
+        self.sink = _progress_sink()
+        self.log = None
+        if log_path is not None:
+            try:
+                log_path.parent.mkdir(parents=True, exist_ok=True)
+                self.log = open(log_path, "a", encoding="utf-8", errors="replace")
+            except OSError:
+                self.log = None
+
+    def say(self, msg):
+        line = f"asperity build: {msg}\n"
+        sys.stderr.write(line)
+        sys.stderr.flush()
+        self._write(line, True)
+
+    def line(self, out):
         sys.stdout.write(out)
         sys.stdout.flush()
-        if tty and re.match(r"\[\d+/\d+\]|\[ *\d+%\]|ninja: ", out):
-            tty.write(out)
-            tty.flush()
+        self._write(out, bool(re.match(r"\[\d+/\d+\]|\[ *\d+%\]|ninja: ", out)))
+
+    def _write(self, text, progress):
+        for f in ((self.log, self.sink) if progress else (self.log,)):
+            if f is None:
+                continue
+            try:
+                f.write(text)
+                f.flush()
+            except OSError:
+                pass
+
+    def close(self):
+        for f in (self.log, self.sink):
+            if f is not None:
+                try:
+                    f.close()
+                except OSError:
+                    pass
+
+
+def _run(args, out):
+    line = "cmake " + " ".join(str(a) for a in args)
+    out.say(line)
+    proc = subprocess.Popen(["cmake", *map(str, args)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True, errors="replace")
+    for text in proc.stdout:
+        out.line(text)
     if proc.wait() != 0:
         raise RuntimeError(f"{line} failed (exit {proc.returncode}); its output is above (pip install -v shows it)")
 
@@ -118,28 +224,25 @@ def _build_dir(config_settings):
 
 def _build(staging, config_settings):
     build, named = _build_dir(config_settings)
-    tty = _terminal()
+    if named and not (build / "CMakeCache.txt").exists():
+        raise RuntimeError(f"{build}: not a configured CMake build directory (no CMakeCache.txt)")
+    out = _Output(build / "asperity-pip.log")
     try:
+        out.say(f"the whole build's output: {build / 'asperity-pip.log'}")
         if not (build / "CMakeCache.txt").exists():
-            if named:
-                raise RuntimeError(f"{build}: not a configured CMake build directory (no CMakeCache.txt)")
-            note = ("first build of the Python module in build/pip: ~60 files, a few minutes on 2 cores; "
+            out.say("first build of the Python module in build/pip: ~60 files, a few minutes on 2 cores; "
                     "later installs rebuild only what changed")
-            _say(note)
-            if tty:
-                print(f"asperity build: {note}", file=tty, flush=True)
             gen = ["-G", "Ninja"] if shutil.which("ninja") and not os.environ.get("CMAKE_GENERATOR") else []
             _run(["-S", ROOT, "-B", build, *gen, "-DCMAKE_BUILD_TYPE=Release", "-DASPERITY_PYTHON=ON",
                   "-DASPERITY_BUILD_TESTS=OFF", "-DASPERITY_BUILD_BENCH=OFF", "-DASPERITY_BUILD_CLI=OFF",
-                  "-DASPERITY_WITH_MPI=OFF", f"-DPython3_EXECUTABLE={sys.executable}"], tty)
+                  "-DASPERITY_WITH_MPI=OFF", f"-DPython3_EXECUTABLE={sys.executable}"], out)
         else:
-            _say(f"reusing the configured build {build}")
+            out.say(f"reusing the configured build {build}")
         jobs = (config_settings or {}).get("jobs") or str(os.cpu_count() or 1)
-        _run(["--build", build, "--target", "asperity_python", "-j", jobs], tty)
-        _run(["--install", build, "--component", "python-wheel", "--prefix", staging], tty)
+        _run(["--build", build, "--target", "asperity_python", "-j", jobs], out)
+        _run(["--install", build, "--component", "python-wheel", "--prefix", staging], out)
     finally:
-        if tty:
-            tty.close()
+        out.close()
     suffix = sysconfig.get_config_var("EXT_SUFFIX")
     if not (Path(staging) / NAME / f"_asperity{suffix}").exists():
         found = sorted(p.name for p in (Path(staging) / NAME).glob("_asperity*"))

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 # Installs the built project into a temporary prefix, then configures, builds and runs
-# tests/consumer against it with find_package(asperity CONFIG REQUIRED), linking asperity::${TARGET}.
+# tests/consumer against it with find_package(asperity CONFIG REQUIRED), linking asperity::${TARGET};
+# then builds and runs the same consumer with pkg-config's flags for the installed asperity-core.pc
+# (TARGET core) or asperity.pc (TARGET asperity), found through PKG_CONFIG_PATH alone.
 file(REMOVE_RECURSE "${WORK_DIR}")
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -14,3 +16,24 @@ run(${CMAKE_COMMAND} -S "${SOURCE_DIR}/tests/consumer" -B "${WORK_DIR}/build"
     -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix -DCMAKE_BUILD_TYPE=Release -DASPERITY_TARGET=${TARGET})
 run(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 run("${WORK_DIR}/build/consumer")
+# pkg-config (issue 42 item 5): the installed .pc file, no other path given.
+file(GLOB_RECURSE _pc "${WORK_DIR}/prefix/*/pkgconfig/asperity.pc")
+if(NOT _pc)
+  message(FATAL_ERROR "no pkgconfig/asperity.pc under ${WORK_DIR}/prefix")
+endif()
+get_filename_component(_pcdir "${_pc}" DIRECTORY)
+get_filename_component(_libdir "${_pcdir}" DIRECTORY)
+set(_module asperity)
+if("${TARGET}" STREQUAL "core")
+  set(_module asperity-core)
+endif()
+set(ENV{PKG_CONFIG_PATH} "${_pcdir}")
+execute_process(COMMAND pkg-config --cflags --libs ${_module} RESULT_VARIABLE rc OUTPUT_VARIABLE flags
+                ERROR_VARIABLE err OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "pkg-config --cflags --libs ${_module} failed (${rc}): ${err}")
+endif()
+message(STATUS "pkg-config --cflags --libs ${_module}: ${flags}")
+separate_arguments(flags UNIX_COMMAND "${flags}")
+run(${CXX} -std=c++20 "${SOURCE_DIR}/tests/consumer/main.cpp" ${flags} -o "${WORK_DIR}/consumer-pkg-config")
+run(${CMAKE_COMMAND} -E env LD_LIBRARY_PATH=${_libdir} "${WORK_DIR}/consumer-pkg-config")

@@ -427,9 +427,10 @@ TEST(CliOutput, EscapeSequencesInNamesAndKeysAreShownEscaped) {
 }
 
 // Issue 33 item 6: --preset fig4 --omega-x 1e-5 skipped every Eq. 28 law, the decisive one too,
-// because Eq. 28 as printed (an info law) is NaN at that spin and the laws of a quantity were
-// tested together. Each law is now evaluated alone: the printed one is skipped, eq28-corrected
-// decides (and the run would have said so in its verdict and exit status).
+// because Eq. 28 as printed (an info law) was NaN at that spin and the laws of a quantity were
+// tested together. Each law is now evaluated alone, so eq28-corrected decides. Issue 41 item 7:
+// Eq. 28 as printed is evaluated at that spin too (laws/theory_impact.cpp, small spin), so it is
+// tested (and rejected, as everywhere) instead of skipped.
 TEST(CliRefusals, OneLawThatCannotBeEvaluatedSkipsOnlyItself) {
   const fs::path out = fresh_dir("tiny-spin");
   const auto r = run_command(vg() + " -q --preset fig4 --asperities 1000 --drops 20000 --omega-x 1e-5 --no-plots --out " +
@@ -443,6 +444,7 @@ TEST(CliRefusals, OneLawThatCannotBeEvaluatedSkipsOnlyItself) {
   };
   EXPECT_NE(row("eq28-corrected"), "skipped") << report.substr(0, 200);
   EXPECT_NE(row("eq28-corrected"), "absent");
+  EXPECT_EQ(row("eq28-printed"), "reject") << report;
   EXPECT_EQ(r.out.find("eq28-corrected (skipped)"), std::string::npos) << r.out;
   fs::remove_all(out);
 }

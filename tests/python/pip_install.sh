@@ -13,8 +13,14 @@ python=$1 src=$2 build=$3
 work=$(mktemp -d "${TMPDIR:-/tmp}/asperity-pip.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 "$python" -m venv --system-site-packages "$work/venv"
-"$work/venv/bin/pip" install --no-index --config-settings build-dir="$build" "$src" \
-  > "$work/pip.log" 2>&1 || { cat "$work/pip.log"; exit 1; }
+# setsid: no controlling terminal, as in CI or a notebook; the build's progress must still reach
+# pip's own output (issue 42 item 4: it went to /dev/tty only), and its whole output the build log.
+setsid -w "$work/venv/bin/pip" install --no-index --config-settings build-dir="$build" "$src" \
+  2>&1 < /dev/null | cat > "$work/pip.log" || { cat "$work/pip.log"; exit 1; }
+grep -q '^asperity build: cmake --build ' "$work/pip.log" \
+  || { cat "$work/pip.log"; echo "FAIL: no build progress in pip's output without a terminal"; exit 1; }
+grep -q '^asperity build: cmake --install ' "$build/asperity-pip.log" \
+  || { echo "FAIL: $build/asperity-pip.log lacks the build's lines"; exit 1; }
 want=$(sed -n 's/^project(asperity VERSION \([0-9.]*\).*/\1/p' "$src/CMakeLists.txt")
 cd "$work"  # not the source tree: the import must find the installed package
 PYTHONPATH= "$work/venv/bin/python" - "$want" "$work/venv" <<'PY'

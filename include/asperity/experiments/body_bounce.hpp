@@ -76,11 +76,13 @@ struct FlightStart {
   double gravity = 9.81;  ///< [m/s^2]
 };
 
+/// The result of next_landing: when and how the flying body first touches the plate.
 struct Landing {
   bool found = false;     ///< false: max_steps reached
   double time = 0;        ///< [s], lower bound within time_tolerance
   RotationState rotation; ///< q and Omega at `time`
-  double z = 0, vz = 0;   ///< centre height [m] and vertical velocity [m/s] at `time`
+  double z = 0;           ///< centre height at `time` [m]
+  double vz = 0;          ///< vertical centre velocity at `time` [m/s]
   Support support;        ///< at body_down(rotation.q)
   double gap = 0;         ///< z - support.h [m] (>= 0 up to rounding)
   std::uint32_t queries = 0;  ///< support queries spent
@@ -89,7 +91,9 @@ struct Landing {
 /// Precomputed bounds of one body: max |c_i| and the extreme principal moments.
 struct BodyBounds {
   double c_max = 0;          ///< max_i |c_i| [m]
-  double j_min = 0, j_max = 0;  ///< smallest / largest principal moment [kg m^2]
+  double j_min = 0;          ///< smallest principal moment [kg m^2]
+  double j_max = 0;          ///< largest principal moment [kg m^2]
+  /// The bounds of body b.
   static BodyBounds of(const RoughBody& b);
 };
 
@@ -100,6 +104,8 @@ Landing next_landing(const RoughBody& b, const BodyBounds& bb, const SupportQuer
 /// Total mechanical energy M |V|^2/2 + Omega . J_world Omega/2 + M g z [J].
 double body_energy(const RoughBody& b, const Rotation& q, const Vec3& V, const Vec3& Omega, double z, double g);
 
+/// A bounce run of rough bodies (run_body_bounces): the experiment, the tangential law, the time
+/// limit per sequence and the landing search.
 struct BodyBounceOptions {
   /// sequences, speed, omega (spin at the first impact), stop_speed, gravity, beta, eps_t,
   /// max_impacts, windows, impact_numbers, bootstrap. density is unused (the bodies carry their
@@ -109,7 +115,7 @@ struct BodyBounceOptions {
   /// The tangential law of every impact (core/tangential.hpp); kinematic uses bounce.eps_t.
   TangentialLaw tangential;
   double max_time = 60;    ///< total time per sequence [s]
-  LandingOptions landing;
+  LandingOptions landing;  ///< the landing search of every flight
 };
 /// Throws std::invalid_argument naming the field and value.
 void validate(const BodyBounceOptions& o);
@@ -118,7 +124,9 @@ void validate(const BodyBounceOptions& o);
 struct BodyBounceStops {
   std::uint64_t slow = 0;         ///< normal approach speed of the contact point < stop_speed
   std::uint64_t no_approach = 0;  ///< the lowest asperity does not approach the plate
-  std::uint64_t max_impacts = 0, max_time = 0, max_steps = 0;
+  std::uint64_t max_impacts = 0;  ///< BounceExperiment::max_impacts reached
+  std::uint64_t max_time = 0;     ///< BodyBounceOptions::max_time reached
+  std::uint64_t max_steps = 0;    ///< a landing search gave up (LandingOptions::max_steps)
 };
 
 /// Every impact of every sequence, in sequence then impact order.
@@ -126,15 +134,18 @@ struct BodyBounceSamples {
   BounceSamples base;                 ///< sequence, k, u, eps (Eq. 1), eps_time, |Omega| before, Omega'_x
   std::vector<Vec3> r;                ///< contact vector, world frame [m]
   std::vector<Vec3> omega_after;      ///< Omega', world frame [rad/s]
-  std::vector<double> energy_before, energy_after;  ///< total energy (potential from the plate) [J]
-  std::vector<double> rot_energy_after, trans_energy_after;  ///< rotational / translational energy after [J]
+  std::vector<double> energy_before;  ///< total energy before the impact (potential from the plate) [J]
+  std::vector<double> energy_after;   ///< total energy after the impact [J]
+  std::vector<double> rot_energy_after;    ///< rotational energy after [J]
+  std::vector<double> trans_energy_after;  ///< translational energy after [J]
   std::vector<double> contact_speed;  ///< -v_n: normal approach speed of the contact point [m/s]
   std::vector<double> work;           ///< P . (v + v')/2 of the contact point velocities [J]
   std::vector<double> flight;         ///< flight time after the impact (NaN after the last) [s]
   std::vector<std::uint32_t> queries; ///< support queries of that flight
   std::vector<double> first_energy;   ///< per sequence: total energy at the first impact [J]
-  BodyBounceStops stops;
-  std::uint64_t flights = 0, support_queries = 0;
+  BodyBounceStops stops;     ///< why the sequences ended
+  std::uint64_t flights = 0;          ///< flights searched for a landing
+  std::uint64_t support_queries = 0;  ///< support queries over all flights
   double seconds = 0;        ///< the sequences (wall)
   double seconds_index = 0;  ///< building the K support trees (wall)
 };
@@ -148,22 +159,25 @@ BodyBounceSamples run_body_bounces(std::span<const RoughBody> bodies, const Body
 
 /// eps and spin in one impact-speed bin.
 struct SpeedBin {
-  double lo = 0, hi = 0;            ///< u range [m/s]
-  std::size_t n = 0;
+  double lo = 0;                    ///< lower end of the u range [m/s]
+  double hi = 0;                    ///< upper end of the u range [m/s]
+  std::size_t n = 0;                ///< impacts in the bin
   Estimate eps;                     ///< mean eps with iid se
-  double eps_q10 = 0, eps_q90 = 0;  ///< 10% / 90% quantiles of eps
+  double eps_q10 = 0;               ///< 10% quantile of eps
+  double eps_q90 = 0;               ///< 90% quantile of eps
   double spin_mean = 0;             ///< mean |Omega| before [rad/s]
 };
 
 /// analyse_bounces (bounce.hpp: speed windows, impact numbers, Eq. 2 fits) plus what only bodies have.
 struct BodyBounceReport {
   std::vector<SpeedBin> by_speed;   ///< 18 equal bins over [stop_speed, speed]
-  BounceVariantReport base;
-  BodyBounceStops stops;
-  double impacts_per_sequence_sd = 0;
-  std::uint32_t impacts_max = 0;
+  BounceVariantReport base;         ///< analyse_bounces of the body impacts
+  BodyBounceStops stops;            ///< why the sequences ended
+  double impacts_per_sequence_sd = 0;  ///< standard deviation of the impacts per sequence
+  std::uint32_t impacts_max = 0;       ///< most impacts of a sequence
   double queries_per_flight = 0;      ///< mean support queries per flight
-  double eps_below_0 = 0, eps_above_1 = 0;  ///< fractions of impacts
+  double eps_below_0 = 0;             ///< fraction of impacts with eps < 0
+  double eps_above_1 = 0;             ///< fraction of impacts with eps > 1
   double rising_fraction = 0;         ///< fraction of impacts with the centre rising (u <= 0)
   double rot_fraction_last = 0;       ///< mean rotational / kinetic energy after the last impact
   double work_identity_max = 0;       ///< max |dE - P.(v+v')/2| / E before, over impacts
@@ -171,8 +185,11 @@ struct BodyBounceReport {
   double short_flights = 0;           ///< fraction of flights shorter than 1 ms (chatter)
   /// Fraction of impacts whose kinetic energy INCREASES, and the largest gain / E before: eps_t = 1
   /// keeps v_t, which takes a tangential impulse whose work has either sign off-centre.
-  double energy_gain_fraction = 0, energy_gain_max = 0;
+  double energy_gain_fraction = 0;
+  double energy_gain_max = 0;         ///< the largest gain / E before (above)
 };
+/// The analysis of `s` (analyse_bounces with b's groups and bootstrap, seeded by `seed`) and the
+/// body-only measures of BodyBounceReport.
 BodyBounceReport analyse_body_bounces(const BodyBounceSamples& s, const BounceExperiment& b, std::uint64_t seed);
 
 }  // namespace asperity
@@ -184,32 +201,38 @@ namespace asperity {
 /// same engine on the paper's body, for comparison), then run_body_bounces and the analysis.
 /// Builds the per-speed-window figures when asked (figures as data; app/ writes them).
 struct MeshBounceExperiment {
-  std::filesystem::path mesh = "meshes/ellipsoid.off";
+  std::filesystem::path mesh = "meshes/ellipsoid.off";  ///< the mesh file (OFF or PLY); empty: spheres
   double scale = 1.0;                    ///< mesh coordinates -> metres
   std::vector<double> smooth;            ///< {a, b, c[, m]} [m]: centres mapped onto that (super)ellipsoid
   double sphere_radius = 3e-3;           ///< mesh empty: R [m]
   std::uint64_t asperities = 100000;     ///< N per body
-  RadiusDistribution radii = RadiusDistribution::fixed(6.5e-7);
+  RadiusDistribution radii = RadiusDistribution::fixed(6.5e-7);  ///< the asperities' radii [m]
   double density = 7850;                 ///< [kg/m^3]
   std::uint64_t bodies = 4;              ///< K explicit bodies
-  std::uint64_t seed = 1;
-  int threads = 0;
+  std::uint64_t seed = 1;                ///< every body and sequence is a pure function of (seed, index)
+  int threads = 0;                       ///< 0 = OpenMP default
   BodyBounceOptions options;             ///< options.bounce.density is ignored (density above)
   bool plots = true;  ///< build the figures (MeshBounceReport::figures)
 };
+/// Throws std::invalid_argument naming the field and value.
 void validate(const MeshBounceExperiment& e);
 
+/// What run_mesh_bounces measured: the body, the analysis and the figures.
 struct MeshBounceReport {
-  MeshBounceExperiment experiment;
-  std::string body_name;
+  MeshBounceExperiment experiment;       ///< the experiment run
+  std::string body_name;                 ///< the mesh file's stem, or "sphere"
   double mass = 0;                       ///< [kg]
   Vec3 principal_moments{0, 0, 0};       ///< [kg m^2], ascending
   double c_max = 0;                      ///< max |c_i| over the bodies [m]
-  BodyBounceReport report;
+  BodyBounceReport report;               ///< analyse_body_bounces of the sequences
   std::vector<NamedFigure> figures;  ///< eps per speed window; built when experiment.plots
   std::vector<std::string> plots;    ///< file names written (filled by app/)
   /// bodies, support trees, sequences, analysis, figures (wall)
-  double seconds_build = 0, seconds_index = 0, seconds_run = 0, seconds_analysis = 0, seconds_plots = 0;
+  double seconds_build = 0;
+  double seconds_index = 0;     ///< building the support trees (wall) [s]
+  double seconds_run = 0;       ///< the sequences (wall) [s]
+  double seconds_analysis = 0;  ///< the analysis (wall) [s]
+  double seconds_plots = 0;     ///< the figures (wall) [s]
 };
 
 /// `base`: the mesh of e.mesh (read by the caller, app/mesh_io.hpp); null when e.mesh is empty

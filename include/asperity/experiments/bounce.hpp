@@ -51,7 +51,9 @@
 
 namespace asperity {
 
+/// How a bounce sequence draws each impact (the variants at the top of this header).
 enum class BounceVariant { paper, paper_printed33, random_orientation, dynamic, paper_corrected28 };
+/// "paper", "paper-printed33", "random-orientation", "dynamic" or "paper-corrected28".
 std::string_view to_string(BounceVariant v);
 /// "paper", "paper-printed33", "random-orientation", "dynamic", "paper-corrected28"; throws std::invalid_argument naming the value.
 BounceVariant parse_bounce_variant(std::string_view s);
@@ -67,12 +69,17 @@ inline constexpr double kMaxBounceSpeed = 1e3;
 /// body turns freely meanwhile: at the ends of these ranges a flight lasts at most 2e6 s; below
 /// them (5e-324 m/s^2) the flight time overflowed, above them (1e19) it vanished below the
 /// resolution of the impact times.
-inline constexpr double kMinGravity = 1e-3, kMaxGravity = 1e4;
+inline constexpr double kMinGravity = 1e-3;
+/// Largest gravity of a bounce sequence [m/s^2] (kMinGravity).
+inline constexpr double kMaxGravity = 1e4;
 
+/// The bouncing-ball experiment of a scene ([experiment] kind = "bounce"): its variants, size,
+/// first impact, stop condition, material and analysis.
 struct BounceExperiment {
-  bool enabled = false;
+  bool enabled = false;          ///< false: no bounce run
+  /// The variants run, each on the same seeds, reported side by side.
   std::vector<BounceVariant> variants{BounceVariant::paper, BounceVariant::random_orientation, BounceVariant::dynamic};
-  std::uint64_t sequences = 100000;
+  std::uint64_t sequences = 100000;  ///< bounce sequences per variant
   double speed = 1.0;        ///< first impact speed -V_z [m/s]
   /// Spin at the first impact, world frame [rad/s]: bodies only (body_bounce.hpp); the sphere
   /// variants start without spin (Sec. V), run_bounces refuses anything else.
@@ -105,6 +112,7 @@ struct BounceExperiment {
   /// Impact numbers k (1 = first impact) grouped for comparison.
   std::vector<unsigned> impact_numbers{1, 2, 5, 10, 20, 40};
 
+  /// Field by field.
   friend bool operator==(const BounceExperiment&, const BounceExperiment&) = default;
 };
 
@@ -113,10 +121,10 @@ void validate(const BounceExperiment& b);
 
 /// Every impact of every sequence, sequence by sequence, in impact order.
 struct BounceSamples {
-  BounceVariant variant = BounceVariant::dynamic;
+  BounceVariant variant = BounceVariant::dynamic;  ///< the variant that made them
   std::optional<SphereParams> sphere;   ///< set by run_bounces (enables the semi-analytic residual law)
   double first_speed = 0;               ///< u_1 [m/s]
-  std::uint64_t sequences = 0;
+  std::uint64_t sequences = 0;          ///< sequences run
   std::vector<std::uint32_t> sequence;  ///< sequence index
   std::vector<std::uint32_t> number;    ///< impact number k = 1, 2, ...
   std::vector<double> speed;            ///< impact speed u_k = -V_z before [m/s]
@@ -126,8 +134,9 @@ struct BounceSamples {
   std::vector<float> omega_x_after;     ///< Omega'_x [rad/s]
   std::vector<std::uint8_t> core;       ///< the central sphere touched (explicit variants)
   std::uint64_t no_impacts = 0;         ///< sequences cut short: contact point not approaching
-  std::uint64_t cells = 0, centres = 0; ///< lazy-sphere cells and centres generated, summed
-  double seconds = 0;
+  std::uint64_t cells = 0;              ///< lazy-sphere cells generated, summed over the sequences
+  std::uint64_t centres = 0;            ///< lazy-sphere centres generated, summed
+  double seconds = 0;                   ///< wall time of the run [s]
 };
 
 /// Free rotation of an isotropic body: q(t) = exp(Omega t) q, Omega the constant world-frame
@@ -141,6 +150,7 @@ struct Flight {
   double time = 0;          ///< [s]
   double landing_vz = 0;    ///< [m/s], <= 0
 };
+/// The Flight from h0 with vz until height D under gravity g [m/s^2].
 Flight ballistic_flight(double h0, double vz, double D, double g);
 
 /// Runs `sequences` sequences of one variant for a sphere (N, R, a). threads = 0: OpenMP default.
@@ -148,6 +158,8 @@ Flight ballistic_flight(double h0, double vz, double D, double g);
 /// kBounceBlock each, well under a second); an exception it throws (the Python module's
 /// KeyboardInterrupt) ends the run and comes out of this call. Results do not depend on the blocks.
 inline constexpr std::uint64_t kBounceBlock = 1024;
+/// The sequences of variant `v` of `b` for `sphere` (the comment above); throws
+/// std::invalid_argument for an experiment the variant refuses (validate, spin, tangential law).
 BounceSamples run_bounces(const SphereParams& sphere, const BounceExperiment& b, BounceVariant v, std::uint64_t seed,
                           int threads = 0, const Progress& progress = {});
 
@@ -158,59 +170,69 @@ struct BounceGroup {
   /// windows: eps_n changes by ~5e-4 across a 0.1 m/s window, 100x the roughness scatter, so the
   /// window's law of eps itself would be eps_n's speed dependence, not the fluctuation).
   std::string quantity;
-  double lo = 0, hi = 0;       ///< window [m/s], or k (lo = hi)
-  std::size_t n = 0;
+  double lo = 0;               ///< window [m/s], or k (lo = hi)
+  double hi = 0;               ///< window's upper end [m/s], or k
+  std::size_t n = 0;           ///< impacts in the group
   double mean_speed = 0;       ///< [m/s]
   Estimate eps_mean;           ///< mean of `quantity` with iid se
-  double eps_std = 0;
+  double eps_std = 0;          ///< standard deviation of `quantity`
   double spin_mean = 0;        ///< mean |Omega| before impact [rad/s]
   Estimate eps_time_minus_eps; ///< mean of eps(times) - eps(velocities) (impacts k >= 2)
   bool fitted = false;         ///< n >= 20
-  LaplaceFit fit;
-  LaplaceGof gof;
+  LaplaceFit fit;              ///< Eq. 2 fit of `quantity` (when fitted)
+  LaplaceGof gof;              ///< its bootstrap goodness of fit
   /// accept, reject (p < alpha) or undecided ("cannot decide at this B": no replicate reached D and
   /// the floor 1/(1+B) is not below alpha); skipped without a bootstrap.
   Verdict gof_verdict = Verdict::skipped;
   /// The residual eps - eps_n(u_k) of every group (for speed windows the same as `quantity`):
   /// mean, sd, Eq. 2 fit (no bootstrap) and its correlation with the impact speed u_k (se 1/sqrt(n)).
   Estimate residual_mean;
-  double residual_std = 0;
-  bool residual_fitted = false;
-  LaplaceFit residual_fit;
-  Estimate speed_residual_correlation;
+  double residual_std = 0;               ///< sd of the residual
+  bool residual_fitted = false;          ///< n >= 20
+  LaplaceFit residual_fit;               ///< Eq. 2 fit of the residual
+  Estimate speed_residual_correlation;   ///< correlation of the residual with u_k
   /// Semi-analytic law of the residual (theory_impact.hpp bounce_residual_laws; for a speed window the
   /// mixture over the impact numbers it holds, weighted by their counts): KS of the residual against
   /// it, and for impact groups its rates. Spheres only (has_theory).
   bool has_theory = false;
-  KsResult theory_ks;
-  double theory_rate_below = 0, theory_rate_above = 0;
+  KsResult theory_ks;              ///< KS of the residual against that law
+  double theory_rate_below = 0;    ///< its rate below the mode (impact groups)
+  double theory_rate_above = 0;    ///< its rate above the mode (impact groups)
   std::vector<double> sorted;  ///< the group's `quantity`, sorted (for figures; not serialised)
 };
 
+/// One variant's analysis (analyse_bounces): its groups and fits, and the checks across them.
 struct BounceVariantReport {
-  BounceVariant variant = BounceVariant::dynamic;
-  std::uint64_t sequences = 0, impacts = 0, no_impacts = 0;
-  double impacts_per_sequence = 0;
-  double seconds = 0;
-  double cells_per_sequence = 0, centres_per_sequence = 0;
-  std::vector<BounceGroup> groups;
+  BounceVariant variant = BounceVariant::dynamic;  ///< the variant analysed
+  std::uint64_t sequences = 0;        ///< sequences run
+  std::uint64_t impacts = 0;          ///< impacts over all sequences
+  std::uint64_t no_impacts = 0;       ///< sequences cut short: contact point not approaching
+  double impacts_per_sequence = 0;    ///< mean impacts per sequence
+  double seconds = 0;                 ///< wall time of the run [s]
+  double cells_per_sequence = 0;      ///< lazy-sphere cells generated per sequence
+  double centres_per_sequence = 0;    ///< lazy-sphere centres generated per sequence
+  std::vector<BounceGroup> groups;    ///< speed windows, then impact numbers
   /// eps from flight times against eps from velocities, all impacts k >= 2.
   std::size_t time_n = 0;
-  double time_diff_mean = 0, time_diff_sd = 0, time_diff_max_abs = 0;
+  double time_diff_mean = 0;     ///< mean of eps(times) - eps(velocities)
+  double time_diff_sd = 0;       ///< its standard deviation
+  double time_diff_max_abs = 0;  ///< its largest magnitude
   double spin_final_mean = 0;   ///< mean |Omega| before the last impact [rad/s]
   /// Lag-1 correlation of eps - eps_n(u) between consecutive impacts of a sequence (k >= 2), and
   /// its iid standard error 1/sqrt(pairs): how much the orientation carried between impacts
   /// correlates consecutive contacts.
   Estimate lag1_correlation;
-  std::size_t lag1_pairs = 0;
+  std::size_t lag1_pairs = 0;    ///< consecutive pairs behind lag1_correlation
 };
 
 /// Two-sample KS between two variants' groups (same grouping): does the variant change the law?
 struct BounceComparison {
-  BounceVariant a, b;
-  std::string by;
-  double lo = 0, hi = 0;
-  KsResult ks;
+  BounceVariant a;    ///< the first variant
+  BounceVariant b;    ///< the second variant
+  std::string by;     ///< the grouping, "speed" or "impact" (BounceGroup::by)
+  double lo = 0;      ///< the group (BounceGroup::lo)
+  double hi = 0;      ///< the group (BounceGroup::hi)
+  KsResult ks;        ///< two-sample KS between the groups' `quantity`
 };
 /// For every pair of variants in `r` and every group present in both (n >= 20 each).
 std::vector<BounceComparison> compare_bounce_variants(const std::vector<BounceVariantReport>& r);

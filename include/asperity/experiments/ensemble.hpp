@@ -25,6 +25,9 @@
 
 namespace asperity {
 
+/// How the drops are made: explicit rough spheres (K spheres x M Haar rotations, every contact
+/// found by a spatial query), or sampled iid from the exact finite-N law of the lowest asperity
+/// (fresh_cap: no sphere is built).
 enum class Mode { explicit_spheres, sampled };
 /// "explicit" or "sampled".
 std::string_view to_string(Mode m);
@@ -59,8 +62,10 @@ std::uint64_t auto_spheres(std::uint64_t asperities, std::uint64_t drops);
 /// the pooled sample 0.87/sqrt(K M), and the quenched deviation of the pooled law c/sqrt(N K)
 /// (0 for the sampled design, whose drops are iid).
 struct DesignScales {
-  double statistical = 0, quenched = 0;
+  double statistical = 0;  ///< 0.87/sqrt(K M): KS distance the pooled sample resolves
+  double quenched = 0;     ///< c/sqrt(N K): KS distance of the pooled law from the ensemble law
 };
+/// The DesignScales of `drops` drops on `spheres` spheres of `asperities` asperities.
 DesignScales design_scales(Mode mode, std::uint64_t asperities, std::uint64_t spheres, std::uint64_t drops);
 
 /// A single impact per drop (paper Sec. IV): the body falls onto a horizontal plate (n = +z) with
@@ -70,8 +75,9 @@ DesignScales design_scales(Mode mode, std::uint64_t asperities, std::uint64_t sp
 /// enough that every velocity, impulse and eps stays finite.
 inline constexpr double kMaxSpeed = 1e8;
 
+/// The impact experiment of a sphere run (scene [experiment] kind = "impact"): one impact per drop.
 struct ImpactExperiment {
-  bool enabled = false;
+  bool enabled = false;          ///< false: contact statistics only
   double speed = 1.3;            ///< u = -V.n > 0 [m/s]
   Vec3 omega{0.2, 0.0, 0.0};     ///< Omega before [rad/s]
   double density = 7850;         ///< [kg/m^3]; mass M = 4/3 pi R^3 density (eps does not depend on it)
@@ -82,6 +88,7 @@ struct ImpactExperiment {
   /// bounces; the paper's bounce procedure refuses them, scene.cpp validate).
   TangentialLaw tangential;
 
+  /// Field by field.
   friend bool operator==(const ImpactExperiment&, const ImpactExperiment&) = default;
 };
 
@@ -107,19 +114,22 @@ inline constexpr std::uint64_t kMaxRawDrops = std::uint64_t{1} << 31;
 /// when statistics = streaming was asked for (validate).
 inline constexpr std::uint64_t kMaxStreamingDrops = std::uint64_t{1} << 50;
 
+/// A sphere run's drops: the sphere, the design and its size, the seed, the query backend and the
+/// impact experiment (validate checks every field).
 struct EnsembleConfig {
-  SphereParams sphere;
-  Mode mode = Mode::explicit_spheres;
+  SphereParams sphere;                ///< N asperities, R, a
+  Mode mode = Mode::explicit_spheres;  ///< explicit spheres or sampled from the exact law
   std::uint64_t drops = 1000000;  ///< total drops (explicit: spheres x rotations)
   std::uint64_t spheres = 1;      ///< K (explicit design); drops must be a multiple of K
-  std::uint64_t seed = 1;
+  std::uint64_t seed = 1;           ///< every drop is a pure function of (seed, drop index)
   Backend backend = Backend::grid;  ///< explicit design only
   Kernel kernel = Kernel::simd;     ///< explicit design: which drop kernel instantiation (the same bits)
   int threads = 0;                  ///< 0 = OpenMP default, at most kMaxThreads
   ImpactExperiment impact;          ///< off: contact statistics only (nothing else is computed)
-  Statistics statistics = Statistics::automatic;
+  Statistics statistics = Statistics::automatic;  ///< raw samples or streaming histograms
   unsigned bins_log2 = 16;          ///< streaming: 2^bins_log2 fine bins per quantity, in [10, 24]
 
+  /// Field by field.
   friend bool operator==(const EnsembleConfig&, const EnsembleConfig&) = default;
 };
 
@@ -137,22 +147,27 @@ void validate(const EnsembleConfig& c);
 /// skipped when it is the run's own backend), fcl when built and N <= kCrossCheckFclMax (its
 /// build is ~0.08 s at 10^5). A disagreement makes run_contact_ensemble throw std::runtime_error.
 struct CrossCheck {
-  std::uint64_t queries = 0, agreed = 0;
-  std::vector<std::string> backends;
-  double seconds = 0;
+  std::uint64_t queries = 0;           ///< queries answered again
+  std::uint64_t agreed = 0;            ///< of them, answered alike by every backend
+  std::vector<std::string> backends;   ///< the backends that answered them again
+  double seconds = 0;                  ///< wall time of the cross-check [s]
 };
 /// Brute-force work of the cross-check, queries x N: ~1.3 ns each, so ~26 ms.
 inline constexpr double kCrossCheckScanBudget = 2e7;
+/// Largest N at which fcl joins the cross-check (its index build grows with N).
 inline constexpr std::uint64_t kCrossCheckFclMax = 20000;
 
 /// Per-drop results, index = drop number (independent of thread count and schedule).
 struct ContactSamples {
-  Mode mode = Mode::explicit_spheres;
+  Mode mode = Mode::explicit_spheres;  ///< the design that made the drops
   std::size_t batches = 0;          ///< explicit: K spheres; sampled: number of drops (iid)
-  std::vector<double> r_x, r_y, r_z, r_xy;  ///< lowest asperity's contact vector, world frame [m]
+  std::vector<double> r_x;          ///< lowest asperity's contact vector, world frame: x [m]
+  std::vector<double> r_y;          ///< y [m]
+  std::vector<double> r_z;          ///< z [m]
+  std::vector<double> r_xy;         ///< its length in the plate's plane, hypot(r_x, r_y) [m]
   std::vector<double> gap;          ///< runner-up height gap [m] (+inf if N == 1)
   std::vector<std::uint8_t> core;   ///< 1 if the central sphere touches first
-  std::uint64_t core_contacts = 0;
+  std::uint64_t core_contacts = 0;  ///< drops where the central sphere touches first
   // Impact results (empty unless the experiment is enabled). The impulse uses the physical contact:
   // the lowest asperity's r, or the central sphere's pole (0, 0, -R) in a core contact.
   std::vector<double> eps;            ///< macroscopic restitution coefficient, Eq. 1
@@ -161,7 +176,10 @@ struct ContactSamples {
   std::vector<std::uint8_t> eps_core; ///< 1 where that impact was a core contact (aligned with eps)
   std::uint64_t no_impacts = 0;       ///< drops whose contact point does not approach the plate (v_n >= 0):
                                       ///< counted here, absent from eps/omega_x_after/eps_n
-  double seconds_generate = 0, seconds_index = 0, seconds_query = 0, seconds_impact = 0;
+  double seconds_generate = 0;      ///< wall time building the spheres [s]
+  double seconds_index = 0;         ///< wall time building their spatial indices [s]
+  double seconds_query = 0;         ///< wall time of the contact queries [s]
+  double seconds_impact = 0;        ///< wall time of the impulse solves [s]
   std::size_t index_bytes = 0;      ///< memory of one spatial index (explicit design)
   CrossCheck cross_check;           ///< explicit design: queries answered again by other backends
 };
@@ -169,6 +187,9 @@ struct ContactSamples {
 /// Called now and then from the calling thread with (drops done, drops total).
 using Progress = std::function<void(std::uint64_t, std::uint64_t)>;
 
+/// Runs the drops of `c` on every OpenMP thread (results independent of their number); `progress`
+/// is called from the calling thread. Throws std::invalid_argument for a bad config (validate) and
+/// std::runtime_error when the cross-check finds a disagreement.
 ContactSamples run_contact_ensemble(const EnsembleConfig& c, const Progress& progress = {});
 
 /// The backends that re-answer the cross-checked queries of a run with backend `main` (CrossCheck).

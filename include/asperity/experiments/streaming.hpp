@@ -25,7 +25,11 @@
 
 namespace asperity {
 
+/// Most blocks of spheres (sampled: of drops) a streaming run keeps apart: the sphere-block
+/// bootstrap of its decisive tests resamples them.
 inline constexpr std::size_t kStreamBlocks = 256;
+/// Each block counts its drops in 2^kStreamCoarseLog2 cells of the reference law's u = F(x): the
+/// grid of the blocks' KS distances (resolution 2^-10).
 inline constexpr unsigned kStreamCoarseLog2 = 10;
 /// The streamed quantities, in this order.
 inline const std::vector<std::string> kStreamQuantities{"r_xy", "r_x", "r_y"};
@@ -34,9 +38,11 @@ inline const std::vector<std::string> kStreamQuantities{"r_xy", "r_x", "r_y"};
 struct StreamState {
   std::uint64_t next_unit = 0;  ///< units [0, next_unit) are done: 4096 rotations of one sphere (sampled: one drop)
   std::vector<BinnedStats> stats;     ///< one per kStreamQuantities
-  std::uint64_t core_contacts = 0;
-  std::uint64_t check_queries = 0, check_agreed = 0;
+  std::uint64_t core_contacts = 0;    ///< drops so far where the central sphere touches first
+  std::uint64_t check_queries = 0;    ///< cross-checked queries so far (CrossCheck)
+  std::uint64_t check_agreed = 0;     ///< of them, answered alike by every backend
   std::uint64_t index_bytes = 0;      ///< largest spatial index built so far
+  /// Field by field (a resumed run's state against the one it was written from).
   friend bool operator==(const StreamState&, const StreamState&) = default;
 };
 
@@ -47,18 +53,22 @@ StreamState initial_stream_state(const EnsembleConfig& c);
 /// Between waves (every ~10^5..10^6 drops) the driver asks stop(): true ends the run with
 /// complete = false after a checkpoint; checkpoint_due(): true writes one and goes on.
 struct StreamHooks {
-  std::function<bool()> stop;
-  std::function<bool()> checkpoint_due;
-  std::function<void(const StreamState&)> checkpoint;
+  std::function<bool()> stop;                             ///< true: checkpoint and end (empty: never)
+  std::function<bool()> checkpoint_due;                   ///< true: write a checkpoint now (empty: never)
+  std::function<void(const StreamState&)> checkpoint;     ///< writes one (empty: none is written)
 };
 
+/// What run_contact_stream returns: the statistics, whether every drop ran, the design and timings.
 struct ContactStream {
-  StreamState state;
-  bool complete = false;
-  std::uint64_t spheres = 0, rotations = 0;  ///< K and M (sampled: drops and 1)
-  double seconds_generate = 0, seconds_index = 0, seconds_query = 0;
+  StreamState state;            ///< the statistics (also what a checkpoint holds)
+  bool complete = false;        ///< false: stopped by StreamHooks::stop after a checkpoint
+  std::uint64_t spheres = 0;    ///< K (sampled: the drops)
+  std::uint64_t rotations = 0;  ///< M rotations per sphere (sampled: 1)
+  double seconds_generate = 0;  ///< wall time building the spheres [s]
+  double seconds_index = 0;     ///< wall time building their spatial indices [s]
+  double seconds_query = 0;     ///< wall time of the queries and the histograms [s]
   std::size_t index_bytes = 0;  ///< largest index of the whole run (resumed runs included)
-  CrossCheck cross_check;
+  CrossCheck cross_check;       ///< queries answered again by other backends (as ContactSamples)
   std::size_t memory_bytes = 0;  ///< of the statistics (all threads' histograms), independent of the drops
 };
 
@@ -67,7 +77,9 @@ struct ContactStream {
 /// moments are accumulated by one process in drop order, so merging the shares (merge_shares)
 /// gives the same bits as one process running everything.
 struct StreamShare {
-  int rank = 0, ranks = 1;
+  int rank = 0;   ///< this process, in [0, ranks)
+  int ranks = 1;  ///< the processes the run is split across
+  /// Field by field.
   friend bool operator==(const StreamShare&, const StreamShare&) = default;
 };
 
