@@ -707,8 +707,8 @@ Law eq28_printed(const ImpactScene& s) {
   // in double precision, far below the 1e-6 required.)
   // Where the signed spike's raw integral cancels (Omega_x = 1 rad/s at fig4's sphere: h + f Omega_x
   // = h + f vanishes at the spike's centre and the raw integral passes through 0, -8.7 at 0.99 and
-  // +8.5 at 1.01), there is no normalised law: the two rules disagree, and the cdf and pdf throw
-  // (a report skips the law, naming why) instead of dividing by rounding noise.
+  // +8.5 at 1.01), there is no normalised law: the two rules disagree, and the cdf throws (a report
+  // skips the law, naming why) and the pdf is NaN, instead of dividing by rounding noise.
   const bool unresolved = P->Z != 0 && std::abs(P->Zcoarse / P->Z - 1.0) > 1e-6;
   if (unresolved)
     d << "; UNDEFINED: the raw integral cancels to rounding (relative change " << num(std::abs(P->Zcoarse / P->Z - 1.0), 2)
@@ -720,7 +720,7 @@ Law eq28_printed(const ImpactScene& s) {
                             " rad/s (relative change " + num(std::abs(P->Zcoarse / P->Z - 1.0), 2) +
                             " between 128 and 256 panels): no normalised law";
     law.cdf = [why](double) -> double { throw std::domain_error(why); };
-    law.pdf = [why](double) -> double { throw std::domain_error(why); };
+    law.pdf = [](double) { return std::numeric_limits<double>::quiet_NaN(); };  // figures draw no curve
     law.mean = std::numeric_limits<double>::quiet_NaN();
     return law;
   }

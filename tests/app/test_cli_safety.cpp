@@ -430,7 +430,8 @@ TEST(CliOutput, EscapeSequencesInNamesAndKeysAreShownEscaped) {
 // because Eq. 28 as printed (an info law) was NaN at that spin and the laws of a quantity were
 // tested together. Each law is now evaluated alone, so eq28-corrected decides. Issue 41 item 7:
 // Eq. 28 as printed is evaluated at that spin too (laws/theory_impact.cpp, small spin), so it is
-// tested (and rejected, as everywhere) instead of skipped.
+// tested (and rejected, as everywhere) instead of skipped; the per-law skip is checked where the
+// printed law is undefined (Omega_x = 1 rad/s).
 TEST(CliRefusals, OneLawThatCannotBeEvaluatedSkipsOnlyItself) {
   const fs::path out = fresh_dir("tiny-spin");
   const auto r = run_command(vg() + " -q --preset fig4 --asperities 1000 --drops 20000 --omega-x 1e-5 --no-plots --out " +
@@ -447,6 +448,23 @@ TEST(CliRefusals, OneLawThatCannotBeEvaluatedSkipsOnlyItself) {
   EXPECT_EQ(row("eq28-printed"), "reject") << report;
   EXPECT_EQ(r.out.find("eq28-corrected (skipped)"), std::string::npos) << r.out;
   fs::remove_all(out);
+  // The per-law skip itself, where Eq. 28 as printed is undefined (Omega_x = 1 rad/s: its raw
+  // integral cancels): it alone is skipped, with its reason; eq28-corrected decides.
+  const fs::path one = fresh_dir("spin-one");
+  const auto r1 = run_command(vg() + " -q --preset fig4 --asperities 1000 --drops 20000 --omega-x 1 --no-plots --out " +
+                              one.string() + " 2>&1");
+  EXPECT_TRUE(r1.status == 0 || r1.status == 1) << r1.out;
+  const std::string report1 = slurp(one / "report.json");
+  const auto row1 = [&](const std::string& law) {
+    const auto at = report1.find("\"law\": \"" + law + "\",\n      \"n\"");
+    const auto v = report1.find("\"verdict\": \"", at);
+    return at == std::string::npos ? std::string("absent") : report1.substr(v + 12, report1.find('"', v + 12) - v - 12);
+  };
+  EXPECT_EQ(row1("eq28-printed"), "skipped") << report1;
+  EXPECT_NE(report1.find("raw integral cancels"), std::string::npos);
+  EXPECT_NE(row1("eq28-corrected"), "skipped");
+  EXPECT_NE(row1("eq28-corrected"), "absent");
+  fs::remove_all(one);
 }
 
 // Issue 33 item 8: kill -9 leaves a staging directory no handler could remove; the next run in the

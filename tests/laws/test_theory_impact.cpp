@@ -526,11 +526,13 @@ TEST(TheoryImpact, PrintedEq28AtSmallSpin) {
   EXPECT_EQ(scaled_raw(5e-324).substr(0, 8), "-1.239e3");
   // Omega_x = 1 rad/s: h + f Omega_x vanishes at the spike's centre and the raw integral passes
   // through 0 (-8.68 at 0.99, +8.51 at 1.01): there the law is undefined and says so (its cdf
-  // throws: a report skips it) instead of a mean of 157 from rounding noise (3dfd20f: 91.9).
+  // throws: a report skips it; its pdf is NaN: a figure draws no curve) instead of a mean of 157
+  // from rounding noise (3dfd20f: 91.9).
   ImpactScene one = fig4();
   one.omega_x = 1.0;
   const Law undefined = eq28_printed(one);
   EXPECT_THROW((void)undefined.cdf(0.5), std::domain_error);
+  EXPECT_TRUE(std::isnan(undefined.pdf(0.5)));
   EXPECT_TRUE(std::isnan(undefined.mean));
   EXPECT_NE(undefined.description.find("UNDEFINED"), std::string::npos) << undefined.description;
   for (double w : {0.99, 1.01}) {
