@@ -2,6 +2,7 @@
 // The cube-map grid backend must agree bit-for-bit with brute_lowest on every query.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -348,6 +349,40 @@ TEST(GridWinners, SparseCellsForceTheFallbacks) {
   for (int side : {30, 40, 60}) {
     const auto q = asperity::detail::make_grid_with(c, side, 0.2);
     EXPECT_EQ(check(*q, c, d), 0) << "side " << side;
+  }
+}
+
+// The winner pipeline of an index above L2 (batch_winners: a three-stage prefetch pipeline, the
+// window's winner from the FP64 records, certified by the guard or the plane bound): every batch
+// size -- tails shorter than the pipeline, the drop loop's 256, a whole batch -- answers as brute force, on a stress grid (0.3 centres per cell: guards and plane bounds
+// fail often, the full search and brute force answer) and on the default grid, with face edges,
+// corners and a non-unit query inside the batches.
+TEST(GridWinners, PipelineAboveL2AnswersAsBruteAtEveryBatchSize) {
+  const auto c = sphere(60000, 71);
+  auto d = directions(3000, 72);
+  const auto sp = special_directions();
+  d.insert(d.begin() + 40, sp.begin(), sp.end());
+  d[70] = 1.5 * d[70];
+  std::vector<Nearest> ref(d.size());
+  const auto nq = static_cast<std::int64_t>(d.size());
+#pragma omp parallel for schedule(dynamic, 16)
+  for (std::int64_t k = 0; k < nq; ++k) ref[static_cast<std::size_t>(k)] = brute_lowest(c, d[static_cast<std::size_t>(k)]);
+  for (int side : {0, 180}) {
+    const auto q = asperity::detail::make_grid_with(c, side, 0);
+    ASSERT_GT(q->memory_bytes(), std::size_t{1} << 20) << "the index must be above the resident size";
+    for (std::size_t chunk : {std::size_t{1}, std::size_t{7}, std::size_t{25}, std::size_t{63}, std::size_t{64},
+                              std::size_t{256}, d.size()}) {
+      std::vector<Nearest> win(d.size());
+      for (std::size_t b = 0; b < d.size(); b += chunk) {
+        const std::size_t n = std::min(chunk, d.size() - b);
+        q->lowest_winners(std::span<const Vec3>(d.data() + b, n), std::span<Nearest>(win.data() + b, n));
+      }
+      int bad = 0;
+      for (std::size_t k = 0; k < d.size() && bad < 10; ++k) {
+        EXPECT_EQ(win[k], asperity::winner_only(ref[k])) << "side " << side << " chunk " << chunk << " query " << k;
+        bad += !(win[k] == asperity::winner_only(ref[k]));
+      }
+    }
   }
 }
 

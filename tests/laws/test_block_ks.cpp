@@ -170,4 +170,49 @@ TEST(BlockKs, RefusesBadInput) {
   EXPECT_THROW(bin_by_block(x, 3), std::invalid_argument);
 }
 
+
+// The bootstrap's values exactly, at G = 2 and 3 blocks, where the sqrt(G / (G - 1)) inflation is
+// 1.41 and 1.22 (the other tests use G >= 50, where it is ~1.01 and a missing factor hides in
+// their tolerances). Block g holds all its samples in cell g (sizes equal), so a replicate with
+// block multiplicities (m_0, ..., m_(G-1)) (sum G) has the pooled-minus-replicate ecdf
+// |(m_0 + ... + m_j) / G - (j + 1) / G| at edge j: every replicate is one of these maxima times
+// sqrt(G / (G - 1)), computed here from all multiplicity vectors.
+TEST(BlockKs, BootstrapReplicatesAreTheInflatedBlockResamplesAtTwoAndThreeBlocks) {
+  for (std::size_t G : {std::size_t{2}, std::size_t{3}}) {
+    BlockBins b;
+    b.blocks = G;
+    for (std::size_t j = 0; j + 1 < G; ++j) b.edges.push_back(double(j) + 0.5);
+    const std::size_t cells = b.cells(), per = 5;
+    b.counts.assign(G * cells, 0);
+    for (std::size_t g = 0; g < G; ++g) b.counts[g * cells + g] = per;
+    b.block_size.assign(G, per);
+    b.n = G * per;
+    for (std::size_t j = 0; j < b.edges.size(); ++j) b.pooled.push_back(double(j + 1) / double(G));
+    // All multiplicity vectors of G draws from G blocks, and their D times the inflation.
+    std::vector<double> allowed;
+    const double inflate = std::sqrt(double(G) / double(G - 1));
+    for (std::size_t m0 = 0; m0 <= G; ++m0)
+      for (std::size_t m1 = 0; m0 + m1 <= G; ++m1) {
+        const std::size_t m[3] = {m0, m1, G - m0 - m1};
+        if (G == 2 && m[2] != 0) continue;
+        double cum = 0, d = 0;
+        for (std::size_t j = 0; j + 1 < G; ++j) {
+          cum += double(m[j]);
+          d = std::max(d, std::abs(cum / double(G) - double(j + 1) / double(G)));
+        }
+        allowed.push_back(d * inflate);
+      }
+    std::vector<double> out;
+    block_bootstrap_ks(b, 11, 3, 0, 400, out);
+    ASSERT_EQ(out.size(), 400u);
+    std::size_t nonzero = 0;
+    for (double v : out) {
+      const bool ok = std::any_of(allowed.begin(), allowed.end(), [v](double a) { return std::abs(v - a) <= 1e-14; });
+      ASSERT_TRUE(ok) << "G " << G << ": replicate " << v << " is no inflated block resample";
+      nonzero += v > 0;
+    }
+    EXPECT_GT(nonzero, 100u) << G;  // (1, 1) has probability 1/2 at G = 2; D = 0 has 6/27 at G = 3
+  }
+}
+
 }  // namespace

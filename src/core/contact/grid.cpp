@@ -269,9 +269,9 @@ inline float candidate_bound(float m) noexcept {
   return static_cast<float>(r * r * (1.0 + 2e-6));
 }
 
-ASPERITY_GRID_CLONES
-Win window_winner(const float* fx, const float* fy, const float* fz, const Pt* pts, const Runs& runs, double dx, double dy,
-                  double dz) noexcept {
+/// The candidates of the window (float key <= T(m)) as one 24-bit mask: run r in bits 8r .. 8r + 7.
+[[gnu::always_inline]] inline std::uint32_t float_candidates(const float* fx, const float* fy, const float* fz,
+                                                             const Runs& runs, double dx, double dy, double dz) noexcept {
   const float fdx = static_cast<float>(dx), fdy = static_cast<float>(dy), fdz = static_cast<float>(dz);
   const v8f INF = v8f{} + std::numeric_limits<float>::infinity();
   const v8i lane = {0, 1, 2, 3, 4, 5, 6, 7};
@@ -289,13 +289,18 @@ Win window_winner(const float* fx, const float* fy, const float* fz, const Pt* p
     mn = o < mn ? o : mn;
   }
   const float T = candidate_bound(mn[0]);
-  // The candidates of the three runs as one 24-bit mask (run r in bits 8r .. 8r + 7).
   const v8i bit = v8i{1, 2, 4, 8, 16, 32, 64, 128};
   v8i m = ((key[0] <= T) & bit) | ((key[1] <= T) & (bit << 8)) | ((key[2] <= T) & (bit << 16));
   m |= __builtin_shuffle(m, v8i{4, 5, 6, 7, 0, 1, 2, 3});
   m |= __builtin_shuffle(m, v8i{2, 3, 0, 1, 6, 7, 4, 5});
   m |= __builtin_shuffle(m, v8i{1, 0, 3, 2, 5, 4, 7, 6});
-  auto bits = static_cast<std::uint32_t>(m[0]);
+  return static_cast<std::uint32_t>(m[0]);
+}
+
+/// The FP64 recheck of the candidates `bits` (float_candidates): contact_key's expression, ties
+/// to the lowest index.
+[[gnu::always_inline]] inline Win recheck(const Pt* pts, const Runs& runs, std::uint32_t bits, double dx, double dy,
+                                          double dz) noexcept {
   Win w{kInf, kNone};
   while (bits) {
     const int t = __builtin_ctz(bits);
@@ -307,6 +312,64 @@ Win window_winner(const float* fx, const float* fy, const float* fz, const Pt* p
   }
   return w;
 }
+
+ASPERITY_GRID_CLONES
+Win window_winner(const float* fx, const float* fy, const float* fz, const Pt* pts, const Runs& runs, double dx, double dy,
+                  double dz) noexcept {
+  return recheck(pts, runs, float_candidates(fx, fy, fz, runs, dx, dy, dz), dx, dy, dz);
+}
+
+/// The window's winner from the FP64 records (contact_key's expression, ties to the lowest index),
+/// top_pair's arithmetic for the smallest key alone: the batch pipeline's kernel above L2, where a
+/// run's records (32 bytes each, ~2-3 cache lines per run) are fewer lines than its three float rows
+/// (one or two lines each) plus the rechecked record, and the memory system, not the arithmetic,
+/// sets the cost. Runs of <= kRowSlots points.
+ASPERITY_GRID_CLONES
+Win window_min64(const Pt* pts, const Runs& runs, double dx, double dy, double dz) noexcept {
+  constexpr int kB = kRowSlots / 4;
+  const v4d DX = {dx, dx, dx, dx}, DY = {dy, dy, dy, dy}, DZ = {dz, dz, dz, dz};
+  const v4d INF = {kInf, kInf, kInf, kInf};
+  const long long none = kNone;
+  v4d key[3 * kB];
+  v4l ids[3 * kB];
+  v4d a1 = INF;
+  for (int r = 0; r < 3; ++r) {
+    const long long n = runs.size[r];
+    const v4l size = {n, n, n, n};
+    for (int q = 0; q < kB; ++q) {
+      if (4 * q >= n) {
+        key[r * kB + q] = INF;
+        ids[r * kB + q] = v4l{none, none, none, none};
+        continue;
+      }
+      const Pt* p = pts + runs.begin[r] + 4u * static_cast<unsigned>(q);
+      const v4d p0 = loadu<v4d>(p), p1 = loadu<v4d>(p + 1), p2 = loadu<v4d>(p + 2), p3 = loadu<v4d>(p + 3);
+      const v4d t0 = __builtin_shuffle(p0, p1, v4l{0, 4, 2, 6}), t1 = __builtin_shuffle(p0, p1, v4l{1, 5, 3, 7});
+      const v4d t2 = __builtin_shuffle(p2, p3, v4l{0, 4, 2, 6}), t3 = __builtin_shuffle(p2, p3, v4l{1, 5, 3, 7});
+      const v4d x = __builtin_shuffle(t0, t2, v4l{0, 1, 4, 5}) - DX, y = __builtin_shuffle(t1, t3, v4l{0, 1, 4, 5}) - DY;
+      const v4d z = __builtin_shuffle(t0, t2, v4l{2, 3, 6, 7}) - DZ;
+      const v4l id = reinterpret_cast<v4l>(__builtin_shuffle(t1, t3, v4l{2, 3, 6, 7}));
+      const v4d k = (x * x + y * y) + z * z;
+      const v4l slot = v4l{0, 1, 2, 3} + 4 * q;
+      key[r * kB + q] = slot < size ? k : INF;
+      ids[r * kB + q] = slot < size ? id : v4l{none, none, none, none};
+      a1 = key[r * kB + q] < a1 ? key[r * kB + q] : a1;
+    }
+  }
+  for (const v4l swap : {v4l{2, 3, 0, 1}, v4l{1, 0, 3, 2}}) {
+    const v4d b1 = __builtin_shuffle(a1, swap);
+    a1 = b1 < a1 ? b1 : a1;
+  }
+  // The lowest index among the keys equal to the smallest (every lane of a1 holds it).
+  v4l e1 = {none, none, none, none};
+  for (int q = 0; q < 3 * kB; ++q) e1 = ((key[q] == a1) & (ids[q] < e1)) ? ids[q] : e1;
+  for (const v4l swap : {v4l{2, 3, 0, 1}, v4l{1, 0, 3, 2}}) {
+    const v4l f1 = __builtin_shuffle(e1, swap);
+    e1 = f1 < e1 ? f1 : e1;
+  }
+  return Win{a1[0], static_cast<std::uint32_t>(e1[0])};
+}
+
 #endif  // ASPERITY_GRID_FAST
 
 // ---- the grid -----------------------------------------------------------------------------------
@@ -319,7 +382,12 @@ struct Loc {
   bool brute = true;
 };
 
+class Grid;
+ASPERITY_GRID_CLONES void resident_winners(const Grid& g, std::span<const Vec3> d, std::span<Nearest> out);
+
 class Grid final : public ContactQuery {
+  friend void resident_winners(const Grid& g, std::span<const Vec3> d, std::span<Nearest> out);
+
  public:
   Grid(std::span<const Vec3> c, int side, double margin) : c_(c) {
     const std::size_t n = c.size();
@@ -358,12 +426,13 @@ class Grid final : public ContactQuery {
 
   void lowest(std::span<const Vec3> d, std::span<Nearest> out) const override {
     if (out.size() != d.size()) throw std::invalid_argument("lowest(): output size differs from input size");
-    batch<false>(d, out, [this](const Loc& L, const Vec3& x) { return L.brute ? brute_lowest(c_, x) : search(L, x); });
+    batch(d, out, [this](const Loc& L, const Vec3& x) { return L.brute ? brute_lowest(c_, x) : search(L, x); });
   }
 
   void lowest_winners(std::span<const Vec3> d, std::span<Nearest> out) const override {
     if (out.size() != d.size()) throw std::invalid_argument("lowest_winners(): output size differs from input size");
-    batch<true>(d, out, [this](const Loc& L, const Vec3& x) { return winner(L, x); });
+    if (memory_bytes() <= kResidentBytes) return resident_winners(*this, d, out);
+    batch_winners(d, out);
   }
 
   std::size_t memory_bytes() const override {
@@ -373,8 +442,8 @@ class Grid final : public ContactQuery {
   }
 
  private:
-  /// Answers a batch by `answer(loc, d)`; Winners: the winner path's data is prefetched.
-  template <bool Winners, class Answer>
+  /// Answers a batch by `answer(loc, d)` (the full path).
+  template <class Answer>
   void batch(std::span<const Vec3> d, std::span<Nearest> out, Answer answer) const {
     // An index that fits in a core's L2 is answered query by query: the pipeline's prefetches
     // then only cost instructions (N = 10^4: -8% CPU per drop; at N = 3x10^4, 1.6 MB, they pay).
@@ -397,7 +466,7 @@ class Grid final : public ContactQuery {
       }
       if (step >= kLag && step - kLag < n) {
         const Loc& L = loc[(step - kLag) % kRing];
-        if (!L.brute) prefetch_points<Winners>(L);
+        if (!L.brute) prefetch_points(L);
       }
       if (step >= 2 * kLag) {
         const std::size_t q = step - 2 * kLag;
@@ -405,6 +474,94 @@ class Grid final : public ContactQuery {
         out[q] = answer(L, d[q]);
       }
     }
+  }
+
+  /// One query of the winner pipeline: where it falls and its 3x3 runs.
+  struct WinSlot {
+    Loc L;
+    Runs runs;
+    std::uint32_t cell = 0;  // j G + i: its guard
+    bool fast = false;       // window_min64 answers it (guard > 0, runs of <= kRowSlots)
+  };
+
+  /// lowest_winners above L2: a three-stage software pipeline over the batch. (A cell-order sweep
+  /// of each batch -- locate all, sort by cell, answer in that order -- measured slower at N = 10^6
+  /// with the drop loop's batches of 256: 389-438 against 325-373 ns per query; bench/RESULTS.md.)
+  /// Query q is located at step q (its cell starts and its guard
+  /// prefetched); at q + kLag its runs are read and every cache line of their FP64 records
+  /// prefetched; at q + 2 kLag the window's winner is computed from the records (window_min64, no
+  /// float rows: at N >= 10^5 the memory system sets the cost, and the records are the fewest lines)
+  /// and certified by the guard or the plane bound, else the full search answers. The winner is
+  /// winner()'s: the smallest FP64 key of the window, ties to the lowest index.
+  void batch_winners(std::span<const Vec3> d, std::span<Nearest> out) const {
+    constexpr std::size_t kLag = 8, kRing = 32;  // >= 2 kLag + 1; a power of two: % is a mask
+    std::array<WinSlot, kRing> ring;
+    const std::size_t n = d.size();
+    const int G = G_;
+    for (std::size_t step = 0; step < n + 2 * kLag; ++step) {
+      if (step < n) {
+        WinSlot& S = ring[step % kRing];
+        S.L = locate(d[step]);
+        S.fast = false;
+        if (!S.L.brute) {
+          S.cell = static_cast<std::uint32_t>(S.L.j * G + S.L.i);
+          prefetch_starts(S.L);
+          prefetch(guard_.data() + S.cell);
+        }
+      }
+      if (step >= kLag && step - kLag < n) {
+        WinSlot& S = ring[(step - kLag) % kRing];
+        if (!S.L.brute) prefetch_runs(S);
+      }
+      if (step >= 2 * kLag) {
+        const std::size_t q = step - 2 * kLag;
+        const WinSlot& S = ring[q % kRing];
+        out[q] = S.fast ? finish(S, d[q]) : winner(S.L, d[q]);
+      }
+    }
+  }
+
+  /// Stage two of batch_winners: the runs of S (S.fast: window_min64 can answer) and a prefetch
+  /// of every cache line of their records.
+  void prefetch_runs(WinSlot& S) const noexcept {
+#if ASPERITY_GRID_FAST
+    const Loc& L = S.L;
+    const int G = G_;
+    if (!(guard_[S.cell] > 0)) return;  // 0 at the face border: winner() decides
+    const std::uint32_t* cs = cs_.data() + L.base + (L.j - 1) * G + (L.i - 1);
+    std::uint32_t big = 0, total = 0;
+    for (int r = 0; r < 3; ++r) {
+      const std::uint32_t b = cs[r * G], sz = cs[r * G + 3] - b;
+      S.runs.begin[r] = b, S.runs.size[r] = sz;
+      big |= sz > static_cast<std::uint32_t>(kRowSlots), total += sz;
+      if (sz == 0 || sz > static_cast<std::uint32_t>(kRowSlots)) continue;
+      // window_min64 reads whole blocks of four records: [b, b + 4 ceil(sz / 4)).
+      const char* lo = reinterpret_cast<const char*>(pts_.data() + b);
+      const char* hi = reinterpret_cast<const char*>(pts_.data() + b + ((sz + 3) & ~3u)) - 1;
+      for (const char* a = lo; a < hi; a += 64) prefetch(a);
+      prefetch(hi);
+    }
+    S.fast = !big && total >= 1;
+#else
+    (void)S;
+#endif
+  }
+
+  /// Stage three of batch_winners for a fast query: winner()'s certificates on window_min64's winner.
+  Nearest finish(const WinSlot& S, const Vec3& d) const {
+#if ASPERITY_GRID_FAST
+    const Win w = window_min64(pts_.data(), S.runs, d.x(), d.y(), d.z());
+    if (w.key < guard_[S.cell]) return Nearest{w.id, w.key, w.id, kInf};
+    const Loc& L = S.L;
+    const double* E = edge_.data();
+    const double db = L.db, dc = L.dc, d3 = L.d3;
+    const double xs = std::min(plane_x(db - E[L.i - 1] * d3, L.i - 1), plane_x(E[L.i + 2] * d3 - db, L.i + 2));
+    const double xt = std::min(plane_x(dc - E[L.j - 1] * d3, L.j - 1), plane_x(E[L.j + 2] * d3 - dc, L.j + 2));
+    if (beyond(std::min(std::min(xs, xt), d3 * d3), w.key)) return Nearest{w.id, w.key, w.id, kInf};
+    return winner_only(search(S.L, d));
+#else
+    return winner(S.L, d);
+#endif
   }
 
   // ---- cell edges -----------------------------------------------------------------------------
@@ -576,18 +733,11 @@ class Grid final : public ContactQuery {
   /// Prefetches the records the fast path reads of the three runs around L: every cache line of
   /// its blocks of four, [b, b + 4 ceil(n / 4)) for a run of n <= kRowSlots points (longer runs
   /// take the general path: their first kRowSlots).
-  /// Winners: the first line of each run's three float rows instead (the records the winner path
-  /// rechecks are usually one, unknown before the float keys).
-  template <bool Winners>
   void prefetch_points(const Loc& L) const noexcept {
     const std::uint32_t* cs = cs_.data() + L.base;
     const int i0 = std::max(L.i - 1, 0), i1 = std::min(L.i + 2, G_);
     for (int r = std::max(L.j - 1, 0); r <= std::min(L.j + 1, G_ - 1); ++r) {
       const std::uint32_t b = cs[r * G_ + i0], n = std::min<std::uint32_t>(cs[r * G_ + i1] - b, kRowSlots);
-      if constexpr (Winners) {
-        prefetch(fx_.data() + b), prefetch(fy_.data() + b), prefetch(fz_.data() + b);
-        continue;
-      }
       const char* lo = reinterpret_cast<const char*>(pts_.data() + b);
       const char* hi = reinterpret_cast<const char*>(pts_.data() + b + ((n + 3) & ~3u));
       for (const char* a = lo; a < hi; a += 64) prefetch(a);
@@ -641,7 +791,10 @@ class Grid final : public ContactQuery {
   /// The winner alone (lowest_winners): the 3x3 window's winner by the float kernel, certified by
   /// the cell's guard (every point outside the window has a key above it, for any direction in the
   /// cell), else by this direction's own plane bound; otherwise the full search decides.
-  Nearest winner(const Loc& L, const Vec3& d) const {
+  /// Inline: the float kernel inlined (the ISA-cloned resident loop) instead of called through
+  /// its own clones' dispatch.
+  template <bool Inline = false>
+  [[gnu::always_inline]] inline Nearest winner(const Loc& L, const Vec3& d) const {
     if (L.brute) return winner_only(brute_lowest(c_, d));
 #if ASPERITY_GRID_FAST
     const int G = G_;
@@ -655,7 +808,12 @@ class Grid final : public ContactQuery {
       }
       if (std::max(std::max(runs.size[0], runs.size[1]), runs.size[2]) <= kRowSlots &&
           runs.size[0] + runs.size[1] + runs.size[2] >= 1) {
-        const Win w = window_winner(fx_.data(), fy_.data(), fz_.data(), pts_.data(), runs, d.x(), d.y(), d.z());
+        Win w;
+        if constexpr (Inline)
+          w = recheck(pts_.data(), runs, float_candidates(fx_.data(), fy_.data(), fz_.data(), runs, d.x(), d.y(), d.z()),
+                      d.x(), d.y(), d.z());
+        else
+          w = window_winner(fx_.data(), fy_.data(), fz_.data(), pts_.data(), runs, d.x(), d.y(), d.z());
         if (w.key < g) return Nearest{w.id, w.key, w.id, kInf};
         const double* E = edge_.data();
         const double db = L.db, dc = L.dc, d3 = L.d3;
@@ -743,6 +901,13 @@ class Grid final : public ContactQuery {
   Array<float> fx_, fy_, fz_;        // pts_'s coordinates rounded to float (+ kPad): the winner path
   std::vector<double> guard_;        // per face cell (j G + i): the winner path's certificate
 };
+
+/// lowest_winners of an index that fits in L2, query by query, the whole loop compiled per ISA
+/// (one dispatch per batch instead of one per query; the same IEEE operations: the same answers).
+ASPERITY_GRID_CLONES
+void resident_winners(const Grid& g, std::span<const Vec3> d, std::span<Nearest> out) {
+  for (std::size_t q = 0; q < d.size(); ++q) out[q] = g.winner<true>(g.locate(d[q]), d[q]);
+}
 
 }  // namespace
 
