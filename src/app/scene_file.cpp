@@ -1011,6 +1011,17 @@ Scene parse_scene(std::string_view toml_text, std::string_view origin) {
   return scene_from_toml(root, origin);
 }
 
+TangentialLaw read_tangential_items(const std::vector<OptionItem>& items, std::string_view origin) {
+  toml::table t;
+  for (const OptionItem& i : items) {
+    const bool fresh = i.number ? t.insert(i.key, *i.number).second : t.insert(i.key, i.text).second;
+    if (!fresh)
+      throw SceneError(std::string(origin) + ": material.tangential." + i.key + ": given twice", "material.tangential." + i.key);
+  }
+  Reader reader(t, "material.tangential", origin);
+  return read_tangential(reader);
+}
+
 Scene load_scene(const std::filesystem::path& file) {
   std::string text;
   try {

@@ -521,17 +521,18 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {M + " --radius 1e-3", "--radius: a mesh body's size"},
       {M + " --mode sampled", "--mode: 'sampled'"},
       {M + " --backend grid", "--backend: not used by a mesh body"},
-      // --tangential (issue 18): the whole value named, each way it can be wrong.
-      {"--preset fig4 --tangential friction:mu=1", "--tangential: 'friction:mu=1' has model 'friction'"},
-      {"--preset fig4 --tangential coulomb:mu=0.3", "'coulomb:mu=0.3' needs restitution=newton|poisson|energetic"},
-      {"--preset fig4 --tangential stronge", "'stronge' needs mu=VALUE"},
-      {"--preset fig4 --tangential stronge:mu=-1", "'stronge:mu=-1' tangential mu must be in [0, 1e12]"},
-      {"--preset fig4 --tangential stronge:mu=x", "--tangential mu: 'x' is not a number"},
-      {"--preset fig4 --tangential stronge:mu=0.3,beta0=1", "has beta0=1, not a key of model stronge"},
-      {"--preset fig4 --tangential stronge:mu=0.3,mu=1", "gives mu twice"},
+      // --tangential (issue 18): read by the one reader of material.tangential (issue 38), each key
+      // named as in a scene file.
+      {"--preset fig4 --tangential friction:mu=1", "--tangential: material.tangential.model: expected one of"},
+      {"--preset fig4 --tangential coulomb:mu=0.3", "--tangential: material.tangential.restitution: missing"},
+      {"--preset fig4 --tangential stronge", "--tangential: material.tangential.mu: missing"},
+      {"--preset fig4 --tangential stronge:mu=-1", "material.tangential.mu: must be in [0, 1e12]"},
+      {"--preset fig4 --tangential stronge:mu=x", "material.tangential.mu: expected a number, got \"x\""},
+      {"--preset fig4 --tangential stronge:mu=0.3,beta0=1", "unknown key 'material.tangential.beta0'"},
+      {"--preset fig4 --tangential stronge:mu=0.3,mu=1", "material.tangential.mu: given twice"},
       {"--preset fig4 --tangential stronge:mu", "has 'mu' where KEY=VALUE belongs"},
       {"--preset fig4 --tangential walton:mu=0.3,beta0=2", "beta0"},
-      {"--preset fig4 --tangential kinematic:eps_t=2", "has eps_t outside [-1, 1]"},
+      {"--preset fig4 --tangential kinematic:eps_t=2", "material.tangential.eps_t: must be in [-1, 1]"},
       {"--preset fig3 --tangential stronge:mu=0.3", "--tangential: needs impacts"},
       {"--preset fig6 --tangential stronge:mu=0.3", "material.tangential.model: coulomb (mu = 0.3, energetic) applies to the explicit variants"},
   };

@@ -7,9 +7,11 @@
 // yet (oblique impacts, constant restitution, ...) are errors
 // "not supported yet: <key> = <value>", never silently ignored.
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "asperity/app/scene.hpp"
 
@@ -32,6 +34,18 @@ class SceneError : public std::invalid_argument {
 /// Parses and validates a scene. Pure (no file or environment access): `origin` only names the
 /// text in messages. Throws SceneError.
 Scene parse_scene(std::string_view toml_text, std::string_view origin = "scene");
+
+/// One KEY=VALUE of an option's value (--tangential coulomb:mu=0.3,...): a number when `number`
+/// holds it, else the text.
+struct OptionItem {
+  std::string key, text;
+  std::optional<double> number;
+};
+
+/// material.tangential from the items of --tangential (model first), read by the one reader of
+/// material.tangential, so each key is checked and worded as in a scene file. Throws SceneError
+/// "<origin>: material.tangential.<key>: <problem>".
+TangentialLaw read_tangential_items(const std::vector<OptionItem>& items, std::string_view origin);
 
 /// Reads and parses a scene file; throws SceneError (also for an unreadable file).
 Scene load_scene(const std::filesystem::path& file);

@@ -379,70 +379,26 @@ void apply_bounce_options(Scene& scene, const RawOptions& r, const Given& given)
   if (given("--variant")) scene.bounce.variants = parse_variants(r["--variant"]);
 }
 
-// --tangential MODEL[:KEY=VALUE[,KEY=VALUE]] (material.tangential of scenes): every key once, each
-// known to its model, the model's required keys given; a bad one is named with the whole value.
-TangentialLaw parse_tangential(const std::string& text) {
-  const std::string opt = "--tangential";
-  auto bad = [&](const std::string& why) { return BadInput(opt + ": '" + text + "' " + why); };
+// --tangential MODEL[:KEY=VALUE[,KEY=VALUE]]: the items of material.tangential, which its one reader
+// checks (scene_file.hpp); a value in decimal notation is a number, any other a name.
+TangentialLaw tangential_option(const std::string& text) {
   const std::size_t colon = text.find(':');
-  const std::string model = text.substr(0, colon);
-  std::map<std::string, std::string> kv;
-  if (colon != std::string::npos) {
-    std::size_t pos = colon + 1;
-    do {
-      const std::size_t comma = text.find(',', pos);
-      const std::string item = text.substr(pos, comma - pos);
-      const std::size_t eq = item.find('=');
-      if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-        throw bad("has '" + item + "' where KEY=VALUE belongs (e.g. coulomb:mu=0.3,restitution=energetic)");
-      if (!kv.emplace(item.substr(0, eq), item.substr(eq + 1)).second) throw bad("gives " + item.substr(0, eq) + " twice");
-      pos = comma == std::string::npos ? comma : comma + 1;
-    } while (pos != std::string::npos);
+  std::vector<OptionItem> items{{"model", text.substr(0, colon), std::nullopt}};
+  for (std::size_t pos = colon; pos != std::string::npos;) {
+    const std::size_t comma = text.find(',', pos + 1);
+    const std::string item = text.substr(pos + 1, comma - pos - 1);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+      throw BadInput("--tangential: '" + text + "' has '" + item + "' where KEY=VALUE belongs (e.g. coulomb:mu=0.3,restitution=energetic)");
+    const std::string value = item.substr(eq + 1);
+    items.push_back({item.substr(0, eq), value, decimal_syntax(value) ? std::optional(parse_real("--tangential", value)) : std::nullopt});
+    pos = comma;
   }
-  std::vector<std::string> keys;  // the model's keys, for the check of unknown ones
-  auto real = [&](const std::string& key, bool required) -> std::optional<double> {
-    keys.push_back(key);
-    const auto it = kv.find(key);
-    if (it == kv.end()) {
-      if (required) throw bad("needs " + key + "=VALUE for model " + model);
-      return std::nullopt;
-    }
-    return parse_real(opt + " " + key, it->second);
-  };
-  TangentialLaw law;
-  if (model == "kinematic") {
-    law = TangentialLaw::kinematic(real("eps_t", false).value_or(1.0));
-    if (law.eps_t < -1 || law.eps_t > 1) throw bad("has eps_t outside [-1, 1]");
-  } else if (model == "coulomb") {
-    const double mu = *real("mu", true);
-    keys.push_back("restitution");
-    const auto it = kv.find("restitution");
-    if (it == kv.end()) throw bad("needs restitution=newton|poisson|energetic for model coulomb");
-    try {
-      law = TangentialLaw::coulomb(mu, parse_normal_rule(it->second));
-    } catch (const std::invalid_argument&) {
-      throw bad("has restitution=" + it->second + " (known: newton, poisson, energetic)");
-    }
-  } else if (model == "stronge") {
-    law = TangentialLaw::stronge(*real("mu", true));
-  } else if (model == "walton") {
-    const double mu = *real("mu", true);
-    law = TangentialLaw::walton(mu, *real("beta0", true));
-  } else {
-    throw bad("has model '" + model + "' (known: kinematic, coulomb, stronge, walton)");
-  }
-  for (const auto& [k, v] : kv)
-    if (std::find(keys.begin(), keys.end(), k) == keys.end()) throw bad("has " + k + "=" + v + ", not a key of model " + model);
-  try {
-    validate(law);
-  } catch (const std::invalid_argument& ex) {
-    throw bad(ex.what());
-  }
-  return law;
+  return read_tangential_items(items, "--tangential");
 }
 
 void apply_tangential_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
-  const TangentialLaw law = parse_tangential(r["--tangential"]);
+  const TangentialLaw law = tangential_option(r["--tangential"]);
   if (k.radii) refuse("--tangential", k.text + " is analysed as contacts only (no impacts)");
   auto& x = scene.ensemble.impact;
   if (!x.enabled && !scene.bounce.enabled)
