@@ -35,7 +35,7 @@ constexpr std::array kRows = {
             kMaxSeed},
   OptionRow{"--backend", "ensemble.backend", "NAME", "brute, kdtree, cgal, fcl, grid", "contact query (explicit design)",
             true},
-  OptionRow{"--threads", "run control", "COUNT", "", "OpenMP threads (0 = all)", false, 0, kMaxThreadCount},
+  OptionRow{"--threads", "ensemble.threads", "COUNT", "", "OpenMP threads (0 = all)", false, 0, kMaxThreadCount},
   OptionRow{"--kernel", "ensemble.kernel", "NAME", "simd, scalar",
             "drop kernel of the explicit drops: simd (default) or scalar (the reference; the same bits)", false},
   OptionRow{"--statistics", "ensemble.statistics", "NAME", "auto, raw, streaming",

@@ -55,7 +55,7 @@ TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
       {"--radius inf", "inf"},            {"--radius 3mm", "3mm"},            {"--radius ''", "''"},
       {"--asperity-radius 0", "'0'"},     {"--asperity-radius 0.003", "smaller"},
       {"--asperity-radius 1 --radius 0.5", "smaller"},                       {"--asperity-radius -1e-7", "-1e-7"},
-      {"--drops 0", "'0'"},             {"--drops 1", "must be >= 2"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
+      {"--drops 0", "got 0"},           {"--drops 1", "must be >= 2"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
       {"--preset fig99", "fig99"},        {"--backend octree --mode fixed", "octree"},
       {"--mode frozen", "frozen"},        {"--alpha 0", "alpha"},             {"--alpha 1.5", "alpha"},
       {"--alpha nan", "alpha"},           {"--threads -1", "-1"},             {"--seed -3", "-3"},

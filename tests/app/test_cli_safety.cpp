@@ -238,7 +238,7 @@ TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
       {"--omega-y 1e6", mesh_bounce_scene(), "must be <= 1000 m/s"},
       {"", "format = 1\n[experiment]\nkind = \"bounce\"\nvariants = \"dynamic,paper,dynamic\"\n", "experiment.variants"},
       // 10: integers as integers
-      {"--seed \" -5\"", "", "--seed: ' -5'"},
+      {"--seed \" -5\"", "", "--seed: ensemble.seed: expected a non-negative 64-bit integer, got \" -5\""},
       {"--asperities 0x10", "", "--asperities: '0x10'"},
       {"--asperities +16", "", "--asperities: '+16'"},
       {"--asperities \" 16\"", "", "--asperities: ' 16'"},

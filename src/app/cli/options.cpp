@@ -13,6 +13,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "asperity/app/option_table.hpp"
@@ -299,10 +300,7 @@ void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, co
 // --drops, --mode, --spheres, --seed: the design of the ensemble.
 void apply_design_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
-  if (given("--drops")) {
-    e.drops = count_option(r, "--drops");  // > 2^31: streaming only (validate)
-    if (k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
-  }
+  if (given("--drops") && k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
   if (given("--mode")) apply_mode_option(scene, r, given, k);
   if (given("--spheres")) {
     e.spheres = count_option(r, "--spheres");
@@ -313,7 +311,6 @@ void apply_design_options(Scene& scene, const RawOptions& r, const Given& given,
       refuse("--spheres", "only for the explicit design (explicit spheres x rotations); sampled drops build no sphere: "
                           "add --mode explicit");
   }
-  if (given("--seed")) e.seed = count_option(r, "--seed");
 }
 
 // --speed, --omega-x, --omega-y: the impact (a mesh body's bounce takes the spin as its start).
@@ -419,7 +416,6 @@ void apply_streaming_options(Scene& scene, RunControl& control, const RawOptions
       throw BadInput("--checkpoint-every: '" + r["--checkpoint-every"] + "' must be a finite number of seconds >= 0");
   }
   if (given("--statistics")) e.statistics = parse_statistics(r["--statistics"]);
-  if (given("--bins-log2")) e.bins_log2 = static_cast<unsigned>(count_option(r, "--bins-log2"));
   if ((given("--statistics") || given("--bins-log2")) && (k.bounce || k.mesh || k.radii))
     refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
 }
@@ -445,18 +441,9 @@ void check_resume_option(const RawOptions& r, const Given& given) {
 
 // --threads, --alpha, --no-plots, --out; and the scene's name says when options changed the physics.
 void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
-  if (given("--threads")) {
-    const std::uint64_t t = count_option(r, "--threads");
-    scene.ensemble.threads = static_cast<int>(t);
-  }
-  if (given("--alpha")) {
-    const double a = parse_real("--alpha", r["--alpha"]);
-    if (!(a > 0 && a < 1)) throw BadInput("--alpha: '" + r["--alpha"] + "' must be in (0, 1)");
-    if (scene.bounce.enabled)
-      throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
-                     "decide nothing (exit status 0)");
-    scene.alpha = a;
-  }
+  if (given("--alpha") && scene.bounce.enabled)
+    throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
+                   "decide nothing (exit status 0)");
   if (r.no_plots) scene.plots = false;
   if (given("--plot-format")) {
     try {
@@ -476,12 +463,35 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
     scene.name += "+custom";
 }
 
+// An option's text as the value a scene file would hold, for the reader to check: a whole number as
+// an integer (a seed above 2^63 - 1 as its digits, as scene files write it), another number as a
+// float, any other text as a string.
+// A float goes through parse_real: a value beyond a double's normal range is named as written.
+std::variant<std::int64_t, double, std::string> scene_value(const std::string& flag, const std::string& text) {
+  if (!decimal_syntax(text)) return text;
+  const long double v = std::strtold(text.c_str(), nullptr);
+  if (v == std::floor(v) && std::fabs(v) < 0x1p63L) return static_cast<std::int64_t>(v);
+  if (flag == "--seed" && text.find_first_not_of("0123456789") == std::string::npos) return text;
+  return parse_real(flag, text);
+}
+
+// The options that are edits of one scene key (their rows' target), read with the scene.
+std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
+  std::vector<SceneEdit> edits;
+  for (const char* flag : {"--drops", "--seed", "--threads", "--bins-log2", "--alpha"})
+    if (given(flag))
+      edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag])});
+  return edits;
+}
+
 // The preset or scene file, then the options over it (docs/scenes.md), in this order: the kind of
 // run is taken after --asperity-radius, which can turn a radii run into the paper's.
 Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoader& load, RunControl& control) {
   if (given("--resume")) check_resume_option(r, given);
   const std::string path = given("--resume") ? (std::filesystem::path(r["--resume"]) / "checkpoint.toml").string() : r["--scene"];
-  Scene scene = !given("--scene") && !given("--resume") ? preset(r["--preset"]) : load ? load(path) : load_scene(path);
+  const std::vector<SceneEdit> edits = scene_edits(r, given);
+  Scene scene = !given("--scene") && !given("--resume") ? preset(r["--preset"], edits) : load ? load(path, edits)
+                                                                                        : load_scene(path, edits);
   if (given("--resume")) scene.out = r["--resume"], control.resume = true;
   apply_body_options(scene, r, given);
   const OptionKind k = option_kind(scene);
