@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -1008,6 +1009,7 @@ void apply_edits(toml::table& root, const std::vector<SceneEdit>& edits) {
       if (!t) throw SceneError(e.option + ": " + e.key + ": the scene's " + part + " is not a table", e.key);
     }
     std::visit([&](const auto& v) { t->insert_or_assign(std::string(key), v); }, e.value);
+    if (!e.replaces.empty()) t->erase(e.replaces);
   }
 }
 
@@ -1018,10 +1020,12 @@ Scene read_edited(const toml::table& root, std::string_view origin, const std::v
     return scene_from_toml(root, origin);
   } catch (const SceneError& e) {
     for (const SceneEdit& ed : edits) {
-      std::string m = e.what();
-      const std::string prefix = std::string(origin) + ": ";
-      if (e.key() != ed.key || m.rfind(prefix, 0) != 0) continue;
-      throw SceneError(ed.option + ": " + m.substr(prefix.size()), e.key());
+      const std::string m = e.what();
+      if (e.key() != ed.key || m.rfind(origin, 0) != 0) continue;
+      std::size_t at = origin.size();  // past "<origin>" and ":<line>" (a rule of the table names no line of the key)
+      if (at + 1 < m.size() && m[at] == ':' && std::isdigit(static_cast<unsigned char>(m[at + 1])))
+        at = m.find_first_not_of("0123456789", at + 1);
+      if (m.compare(at, 2, ": ") == 0) throw SceneError(ed.option + ": " + m.substr(at + 2), e.key());
     }
     throw;
   }

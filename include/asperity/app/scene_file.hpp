@@ -59,6 +59,7 @@ struct SceneEdit {
   std::string key;     ///< dotted: "ensemble.drops"
   std::string option;  ///< "--drops"
   std::variant<std::int64_t, double, std::string> value;
+  std::string replaces;  ///< a key of the same table that this one replaces (removed): "areal_density"
 };
 
 /// parse_scene, load_scene and preset with `edits` applied to the table before it is read.

@@ -264,7 +264,6 @@ OptionKind option_kind(const Scene& scene) {
 // --asperities, --radius, --asperity-radius.
 void apply_body_options(Scene& scene, const RawOptions& r, const Given& given) {
   auto& e = scene.ensemble;
-  if (given("--asperities")) e.sphere.asperities = count_option(r, "--asperities");
   if (given("--radius")) {
     const double radius = parse_positive("--radius", r["--radius"]);
     if (scene.mesh)
@@ -338,10 +337,8 @@ void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given,
     refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
 }
 
-void apply_backend_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
-  auto& e = scene.ensemble;
-  e.backend = parse_backend(r["--backend"]);
-  scene.backend_auto = false;
+void apply_backend_option(const Scene& scene, const OptionKind& k) {
+  const auto& e = scene.ensemble;
   if (k.bounce || k.mesh || k.radii)
     refuse("--backend", "not used by " + k.text + (k.bounce ? "" : ", which queries the exact support tree"));
   if (e.mode != Mode::explicit_spheres)
@@ -407,15 +404,12 @@ void apply_tangential_option(Scene& scene, const RawOptions& r, const OptionKind
 }
 
 // --statistics, --bins-log2 (sphere contact runs), --checkpoint-every (streaming runs).
-void apply_streaming_options(Scene& scene, RunControl& control, const RawOptions& r, const Given& given,
-                             const OptionKind& k) {
-  auto& e = scene.ensemble;
+void apply_streaming_options(RunControl& control, const RawOptions& r, const Given& given, const OptionKind& k) {
   if (given("--checkpoint-every")) {
     control.checkpoint_seconds = parse_real("--checkpoint-every", r["--checkpoint-every"]);
     if (!(control.checkpoint_seconds >= 0) || !std::isfinite(control.checkpoint_seconds))
       throw BadInput("--checkpoint-every: '" + r["--checkpoint-every"] + "' must be a finite number of seconds >= 0");
   }
-  if (given("--statistics")) e.statistics = parse_statistics(r["--statistics"]);
   if ((given("--statistics") || given("--bins-log2")) && (k.bounce || k.mesh || k.radii))
     refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
 }
@@ -470,6 +464,7 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
 std::variant<std::int64_t, double, std::string> scene_value(const std::string& flag, const std::string& text) {
   if (!decimal_syntax(text)) return text;
   const long double v = std::strtold(text.c_str(), nullptr);
+  if (v == std::floor(v) && text[0] == '+') return text;  // whole numbers are written without a sign
   if (v == std::floor(v) && std::fabs(v) < 0x1p63L) return static_cast<std::int64_t>(v);
   if (flag == "--seed" && text.find_first_not_of("0123456789") == std::string::npos) return text;
   return parse_real(flag, text);
@@ -478,9 +473,10 @@ std::variant<std::int64_t, double, std::string> scene_value(const std::string& f
 // The options that are edits of one scene key (their rows' target), read with the scene.
 std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
   std::vector<SceneEdit> edits;
-  for (const char* flag : {"--drops", "--seed", "--threads", "--bins-log2", "--alpha"})
+  for (const char* flag : {"--asperities", "--drops", "--seed", "--backend", "--threads", "--statistics", "--bins-log2", "--alpha"})
     if (given(flag))
-      edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag])});
+      edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag]),
+                       std::string_view(flag) == "--asperities" ? "areal_density" : ""});
   return edits;
 }
 
@@ -497,11 +493,11 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   const OptionKind k = option_kind(scene);
   apply_design_options(scene, r, given, k);
   apply_impact_options(scene, r, given, k);
-  if (given("--backend")) apply_backend_option(scene, r, k);
+  if (given("--backend")) apply_backend_option(scene, k);
   if (given("--kernel")) apply_kernel_option(scene, r, k);
   apply_bounce_options(scene, r, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
-  apply_streaming_options(scene, control, r, given, k);
+  apply_streaming_options(control, r, given, k);
   apply_run_options(scene, r, given);
   return scene;  // the cross-key rules: plan() (plan.hpp), once per run
 }
