@@ -30,8 +30,10 @@ std::string_view preset_text(std::string_view name) {
   throw std::invalid_argument("unknown preset '" + std::string(name) + "' (known: " + known + ")");
 }
 
-Scene preset(std::string_view name) {
-  return parse_scene(preset_text(name), "preset " + std::string(name) + " (scenes/" + std::string(name) + ".toml)");
+Scene preset(std::string_view name) { return preset(name, {}); }
+
+Scene preset(std::string_view name, const std::vector<SceneEdit>& edits) {
+  return parse_scene(preset_text(name), "preset " + std::string(name) + " (scenes/" + std::string(name) + ".toml)", edits);
 }
 
 namespace {

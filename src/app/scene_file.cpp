@@ -11,6 +11,7 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -19,6 +20,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <variant>
 
 namespace asperity {
 
@@ -993,7 +995,47 @@ std::filesystem::path resolve_mesh(const std::filesystem::path& mesh, const std:
 
 }  // namespace
 
-Scene parse_scene(std::string_view toml_text, std::string_view origin) {
+namespace {
+
+// The command line's edits, before the one reading: each key set, its tables made when absent.
+void apply_edits(toml::table& root, const std::vector<SceneEdit>& edits) {
+  for (const SceneEdit& e : edits) {
+    toml::table* t = &root;
+    std::string_view key = e.key;
+    for (std::size_t dot; (dot = key.find('.')) != std::string_view::npos; key.remove_prefix(dot + 1)) {
+      const std::string part(key.substr(0, dot));
+      if (!t->contains(part)) t->insert(part, toml::table{});
+      t = (*t)[part].as_table();
+      if (!t) throw SceneError(e.option + ": " + e.key + ": the scene's " + part + " is not a table", e.key);
+    }
+    std::visit([&](const auto& v) { t->insert_or_assign(std::string(key), v); }, e.value);
+    if (!e.replaces.empty()) t->erase(e.replaces);
+  }
+}
+
+// The one reading; a problem with an edited key is named by its option (the edited value has no
+// line: the message starts with the origin alone).
+Scene read_edited(const toml::table& root, std::string_view origin, const std::vector<SceneEdit>& edits) {
+  try {
+    return scene_from_toml(root, origin);
+  } catch (const SceneError& e) {
+    for (const SceneEdit& ed : edits) {
+      const std::string m = e.what();
+      if (e.key() != ed.key || m.rfind(origin, 0) != 0) continue;
+      std::size_t at = origin.size();  // past "<origin>" and ":<line>" (a rule of the table names no line of the key)
+      if (at + 1 < m.size() && m[at] == ':' && std::isdigit(static_cast<unsigned char>(m[at + 1])))
+        at = m.find_first_not_of("0123456789", at + 1);
+      if (m.compare(at, 2, ": ") == 0) throw SceneError(ed.option + ": " + m.substr(at + 2), e.key());
+    }
+    throw;
+  }
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view toml_text, std::string_view origin) { return parse_scene(toml_text, origin, {}); }
+
+Scene parse_scene(std::string_view toml_text, std::string_view origin, const std::vector<SceneEdit>& edits) {
   if (toml_text.size() > kMaxSceneBytes)
     throw SceneError(std::string(origin) + ": a scene is at most 1 MiB of TOML, this one has " +
                          std::to_string(toml_text.size()) + " bytes",
@@ -1008,17 +1050,31 @@ Scene parse_scene(std::string_view toml_text, std::string_view origin) {
                          std::string(e.description()),
                      "");
   }
-  return scene_from_toml(root, origin);
+  apply_edits(root, edits);
+  return read_edited(root, origin, edits);
 }
 
-Scene load_scene(const std::filesystem::path& file) {
+TangentialLaw read_tangential_items(const std::vector<OptionItem>& items, std::string_view origin) {
+  toml::table t;
+  for (const OptionItem& i : items) {
+    const bool fresh = i.number ? t.insert(i.key, *i.number).second : t.insert(i.key, i.text).second;
+    if (!fresh)
+      throw SceneError(std::string(origin) + ": material.tangential." + i.key + ": given twice", "material.tangential." + i.key);
+  }
+  Reader reader(t, "material.tangential", origin);
+  return read_tangential(reader);
+}
+
+Scene load_scene(const std::filesystem::path& file) { return load_scene(file, {}); }
+
+Scene load_scene(const std::filesystem::path& file, const std::vector<SceneEdit>& edits) {
   std::string text;
   try {
     text = read_bounded_file(file, kMaxSceneBytes, "scene file");
   } catch (const InputFileError& e) {
     throw SceneError(e.what(), "");
   }
-  Scene s = parse_scene(text, file.string());
+  Scene s = parse_scene(text, file.string(), edits);
   if (s.mesh) s.mesh->file = resolve_mesh(s.mesh->file, file, file.parent_path());
   return s;
 }

@@ -48,14 +48,14 @@ struct Bad {
 
 TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
   const std::vector<Bad> cases = {
-      {"--asperities 0", "'0'"},          {"--asperities -5", "-5"},          {"--asperities abc", "abc"},
+      {"--asperities 0", "got 0"},          {"--asperities -5", "-5"},          {"--asperities abc", "abc"},
       {"--asperities 1.5", "1.5"},        {"--asperities nan", "nan"},        {"--asperities inf", "inf"},
-      {"--asperities 1e40", "1e40"},      {"--asperities 5000000000", "5000000000"},
+      {"--asperities 1e40", "1e+40"},      {"--asperities 5000000000", "5000000000"},
       {"--radius 0", "'0'"},              {"--radius -1", "-1"},              {"--radius nan", "nan"},
       {"--radius inf", "inf"},            {"--radius 3mm", "3mm"},            {"--radius ''", "''"},
       {"--asperity-radius 0", "'0'"},     {"--asperity-radius 0.003", "smaller"},
       {"--asperity-radius 1 --radius 0.5", "smaller"},                       {"--asperity-radius -1e-7", "-1e-7"},
-      {"--drops 0", "'0'"},             {"--drops 1", "drops must be >= 2"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
+      {"--drops 0", "got 0"},           {"--drops 1", "must be >= 2"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
       {"--preset fig99", "fig99"},        {"--backend octree --mode fixed", "octree"},
       {"--mode frozen", "frozen"},        {"--alpha 0", "alpha"},             {"--alpha 1.5", "alpha"},
       {"--alpha nan", "alpha"},           {"--threads -1", "-1"},             {"--seed -3", "-3"},
@@ -515,23 +515,24 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {L + " --mode fixed", "--mode: 'fixed'"},
       {L + " --speed 1", "--speed: a run with unequal asperity radii on a sphere"},
       {L + " --omega-y 1", "--omega-y: a run with unequal asperity radii on a sphere"},
-      {L + " --backend grid", "--backend: not used by a run with unequal asperity radii"},
+      {L + " --backend grid", "--backend: ensemble.backend: only mode = \"explicit\" queries a contact index"},
       {L + " --spheres 3", "--spheres: not used by a run with unequal asperity radii"},
       {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
       {M + " --radius 1e-3", "--radius: a mesh body's size"},
       {M + " --mode sampled", "--mode: 'sampled'"},
-      {M + " --backend grid", "--backend: not used by a mesh body"},
-      // --tangential (issue 18): the whole value named, each way it can be wrong.
-      {"--preset fig4 --tangential friction:mu=1", "--tangential: 'friction:mu=1' has model 'friction'"},
-      {"--preset fig4 --tangential coulomb:mu=0.3", "'coulomb:mu=0.3' needs restitution=newton|poisson|energetic"},
-      {"--preset fig4 --tangential stronge", "'stronge' needs mu=VALUE"},
-      {"--preset fig4 --tangential stronge:mu=-1", "'stronge:mu=-1' tangential mu must be in [0, 1e12]"},
-      {"--preset fig4 --tangential stronge:mu=x", "--tangential mu: 'x' is not a number"},
-      {"--preset fig4 --tangential stronge:mu=0.3,beta0=1", "has beta0=1, not a key of model stronge"},
-      {"--preset fig4 --tangential stronge:mu=0.3,mu=1", "gives mu twice"},
+      {M + " --backend grid", "--backend: ensemble.backend: mesh bodies and unequal asperity radii"},
+      // --tangential (issue 18): read by the one reader of material.tangential (issue 38), each key
+      // named as in a scene file.
+      {"--preset fig4 --tangential friction:mu=1", "--tangential: material.tangential.model: expected one of"},
+      {"--preset fig4 --tangential coulomb:mu=0.3", "--tangential: material.tangential.restitution: missing"},
+      {"--preset fig4 --tangential stronge", "--tangential: material.tangential.mu: missing"},
+      {"--preset fig4 --tangential stronge:mu=-1", "material.tangential.mu: must be in [0, 1e12]"},
+      {"--preset fig4 --tangential stronge:mu=x", "material.tangential.mu: expected a number, got \"x\""},
+      {"--preset fig4 --tangential stronge:mu=0.3,beta0=1", "unknown key 'material.tangential.beta0'"},
+      {"--preset fig4 --tangential stronge:mu=0.3,mu=1", "material.tangential.mu: given twice"},
       {"--preset fig4 --tangential stronge:mu", "has 'mu' where KEY=VALUE belongs"},
       {"--preset fig4 --tangential walton:mu=0.3,beta0=2", "beta0"},
-      {"--preset fig4 --tangential kinematic:eps_t=2", "has eps_t outside [-1, 1]"},
+      {"--preset fig4 --tangential kinematic:eps_t=2", "material.tangential.eps_t: must be in [-1, 1]"},
       {"--preset fig3 --tangential stronge:mu=0.3", "--tangential: needs impacts"},
       {"--preset fig6 --tangential stronge:mu=0.3", "material.tangential.model: coulomb (mu = 0.3, energetic) applies to the explicit variants"},
   };

@@ -238,11 +238,11 @@ TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
       {"--omega-y 1e6", mesh_bounce_scene(), "must be <= 1000 m/s"},
       {"", "format = 1\n[experiment]\nkind = \"bounce\"\nvariants = \"dynamic,paper,dynamic\"\n", "experiment.variants"},
       // 10: integers as integers
-      {"--seed \" -5\"", "", "--seed: ' -5'"},
-      {"--asperities 0x10", "", "--asperities: '0x10'"},
-      {"--asperities +16", "", "--asperities: '+16'"},
-      {"--asperities \" 16\"", "", "--asperities: ' 16'"},
-      {"--asperities 9007199254740993", "", "'9007199254740993' must be <= 4294967295"},
+      {"--seed \" -5\"", "", "--seed: ensemble.seed: expected a non-negative 64-bit integer, got \" -5\""},
+      {"--asperities 0x10", "", "--asperities: asperities.count: expected a whole number, got \"0x10\""},
+      {"--asperities +16", "", "--asperities: asperities.count: expected a whole number, got \"+16\""},
+      {"--asperities \" 16\"", "", "--asperities: asperities.count: expected a whole number, got \" 16\""},
+      {"--asperities 9007199254740993", "", "asperities.count: must be <= 4294967295, got 9007199254740993"},
       {"--out= --no-plots", "", "--out: ''"},
       // 12: one rotation per body; radius levels capped
       {"--drops 2 --spheres 2", mesh_scene(""), "ensemble.drops (--drops)"},
@@ -262,8 +262,8 @@ TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
        "at most 16 levels"},
       // 13: numbers out of range are numbers; ranges name the option or key
       {"--alpha 4.9e-324", "", "--alpha: '4.9e-324' is out of range"},
-      {"--asperities 1e-400", "", "--asperities: '1e-400' must be a whole number"},
-      {"--asperities 5000000000", "", "--asperities: '5000000000' must be <= 4294967295"},
+      {"--asperities 1e-400", "", "--asperities: '1e-400' is out of range"},
+      {"--asperities 5000000000", "", "--asperities: asperities.count: must be <= 4294967295, got 5000000000"},
       {"", "format = 1\n[ensemble]\nthreads = 2000\n", ":3: ensemble.threads: must be <= 1024"},
       {"--foo 1 --bar 2", "", "not expected: --foo 1 --bar 2"},
   };

@@ -15,7 +15,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto args = asperity::fuzz::split_lines(data, size);
   try {
     // --scene FILE: never read files while fuzzing (the scene parser has its own target).
-    const auto o = asperity::cli::parse_command_line(args, [](const std::string& file) -> asperity::Scene {
+    const auto o = asperity::cli::parse_command_line(args, [](const std::string& file, const std::vector<asperity::SceneEdit>&) -> asperity::Scene {
       throw asperity::cli::BadInput("--scene: '" + file + "' (files are not read while fuzzing)");
     });
     if (o.help) return o.help_text.empty() ? (std::abort(), 0) : 0;

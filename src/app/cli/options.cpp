@@ -13,8 +13,10 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
+#include "asperity/app/option_table.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/run.hpp"
@@ -132,59 +134,45 @@ std::uint64_t parse_count(const std::string& option, const std::string& text, st
   return v;
 }
 
-// The options as the user wrote them: every value is text until its own parser reads it, so that a
-// bad value is named as written.
+// The options as the user wrote them, by long flag: every value is text until its own parser
+// reads it, so that a bad value is named as written.
 struct RawOptions {
-  std::string preset_name = "fig3", asperities, radius, asperity_radius, drops, spheres, mode, backend, seed, out;
-  std::string threads, alpha, statistics, bins_log2, checkpoint_every, resume;
+  std::map<std::string, std::string, std::less<>> values{{"--preset", "fig3"}};
   bool no_plots = false, quiet = false;
-  std::string plot_format;
-  std::string scene_file;
-  std::string speed, omega_x, omega_y;
-  std::string variants, sequences;
-  std::string tangential;
-  std::string kernel;
+  const std::string& operator[](std::string_view flag) const {
+    static const std::string none;
+    const auto it = values.find(flag);
+    return it == values.end() ? none : it->second;
+  }
 };
 
+// The options that change no result (--resume takes only these), from their rows.
+std::string result_free_options() {
+  std::string list;
+  for (const OptionRow& row : option_rows())
+    if (!row.changes_result && long_flag(row) != "--resume") list += (list.empty() ? "" : ", ") + std::string(long_flag(row));
+  return list;
+}
+
+// A COUNT option in its row's range.
+std::uint64_t count_option(const RawOptions& r, std::string_view flag) {
+  const OptionRow& row = option_row(flag);
+  return parse_count(std::string(flag), r[flag], row.lo, row.hi);
+}
+
+// The options from their rows (option_table.hpp): type, range and help in --help.
 void add_options(CLI::App& app, RawOptions& r) {
-  auto* preset_opt = app.add_option("--preset", r.preset_name, "scene preset: fig3 (default), fig3-fixed, fig4, fig5, fig6");
-  app.add_option("--scene", r.scene_file, "scene file (TOML, see docs/scenes.md); the options below override it")
-      ->excludes(preset_opt);
-  app.add_option("--asperities,-N", r.asperities, "number of asperities N (>= 1)");
-  app.add_option("--radius", r.radius, "central sphere radius R [m]");
-  app.add_option("--asperity-radius", r.asperity_radius, "asperity radius a [m], 0 < a < R");
-  app.add_option("--drops", r.drops, "number of drops (explicit: spheres x rotations)");
-  app.add_option("--mode", r.mode,
-                 "explicit (default: K explicit spheres x M rotations, contacts by spatial query) or sampled (drawn "
-                 "from the exact finite-N law of the lowest asperity; no geometry); fixed and fresh are read as explicit");
-  app.add_option("--spheres,-K", r.spheres, "number of explicit spheres K (explicit design; default: from the error budget)");
-  app.add_option("--seed", r.seed, "random seed (results are identical for any thread count)");
-  app.add_option("--backend", r.backend, "contact query: brute, kdtree, cgal, fcl, grid (explicit design)");
-  app.add_option("--threads", r.threads, "OpenMP threads (0 = all)");
-  app.add_option("--kernel", r.kernel, "drop kernel of the explicit drops: simd (default) or scalar (the reference; the same bits)");
-  app.add_option("--statistics", r.statistics,
-                 "auto (default: streaming above 2^25 drops without impacts), raw (every drop kept: exact KS, figures "
-                 "of every quantity) or streaming (integer histograms, memory independent of the drops; contact only)");
-  app.add_option("--bins-log2", r.bins_log2, "streaming: 2^k fine bins per quantity, k in [10, 24] (default 16)");
-  app.add_option("--checkpoint-every", r.checkpoint_every,
-                 "streaming: seconds between checkpoints in --out (default 300; 0: only on SIGINT/SIGTERM)");
-  app.add_option("--resume", r.resume,
-                 "continue the interrupted streaming run whose checkpoint is in DIR (its scene; only --threads, --kernel, "
-                 "--quiet, --no-plots, --checkpoint-every may be given)")
-      ->excludes(preset_opt);
-  app.add_option("--alpha", r.alpha, "significance level of each test and of the run's family of decisive tests (Holm), in (0,1)");
-  app.add_option("--out", r.out, "output directory for report.json and figures");
-  app.add_option("--speed", r.speed, "impact: approach speed -V.n [m/s] (enables the impact stage)");
-  app.add_option("--omega-x", r.omega_x, "impact: spin Omega_x before [rad/s]");
-  app.add_option("--omega-y", r.omega_y, "impact: spin Omega_y before [rad/s]");
-  app.add_option("--variant", r.variants, "bounce runs (fig6): comma list of paper, paper-printed33, paper-corrected28, random-orientation, dynamic");
-  app.add_option("--sequences", r.sequences, "bounce runs (fig6): bounce sequences per variant");
-  app.add_option("--tangential", r.tangential,
-                 "tangential law of the impacts: kinematic[:eps_t=E], coulomb:mu=M,restitution=newton|poisson|energetic, "
-                 "stronge:mu=M, walton:mu=M,beta0=B (sphere impacts, the explicit bounce variants, mesh bodies)");
-  app.add_flag("--no-plots", r.no_plots, "do not write figures (nor their data, CSV)");
-  app.add_option("--plot-format", r.plot_format, "figures as png (default), svg, pdf, png+svg or png+pdf, optionally @S for S times the size (png@2); CSV always");
-  app.add_flag("--quiet,-q", r.quiet, "print no progress");
+  for (const OptionRow& row : option_rows()) {
+    const std::string flag(row.flag), name(long_flag(row));
+    std::string help(row.help);
+    if (name == "--resume") help += "; only " + result_free_options() + " may be given with it";
+    if (row.type.empty()) {
+      app.add_flag(flag, name == "--quiet" ? r.quiet : r.no_plots, help);
+      continue;
+    }
+    CLI::Option* opt = app.add_option(flag, r.values[name], help)->type_name(type_text(row));
+    if (name == "--scene" || name == "--resume") opt->excludes("--preset");
+  }
 }
 
 // "--out=" (nothing after '='): CLI11 would take the next argument as the value.
@@ -276,9 +264,8 @@ OptionKind option_kind(const Scene& scene) {
 // --asperities, --radius, --asperity-radius.
 void apply_body_options(Scene& scene, const RawOptions& r, const Given& given) {
   auto& e = scene.ensemble;
-  if (given("--asperities")) e.sphere.asperities = parse_count("--asperities", r.asperities, 1, kMaxAsperities);
   if (given("--radius")) {
-    const double radius = parse_positive("--radius", r.radius);
+    const double radius = parse_positive("--radius", r["--radius"]);
     if (scene.mesh)
       refuse("--radius", "a mesh body's size is its mesh file x body.scale (body.kind = \"mesh\"); --radius is the "
                          "radius of a sphere body");
@@ -287,14 +274,14 @@ void apply_body_options(Scene& scene, const RawOptions& r, const Given& given) {
   if (given("--asperity-radius")) {
     // Every asperity gets this radius: the option replaces a "levels"/"lognormal" distribution of
     // the file by "fixed" (on a sphere the run becomes the paper's; a mesh stays a mesh run).
-    e.sphere.asperity_radius = parse_positive("--asperity-radius", r.asperity_radius);
+    e.sphere.asperity_radius = parse_positive("--asperity-radius", r["--asperity-radius"]);
     scene.radii.reset();
   }
 }
 
 void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
-  const std::string& mode = r.mode;
+  const std::string& mode = r["--mode"];
   e.mode = parse_mode(mode);
   // Earlier names: "fixed" = explicit; "fresh" = explicit (with a note), for unequal radii their sampler.
   scene.legacy_mode = is_legacy_mode(mode) && !k.radii && !k.mesh && !k.bounce ? mode : std::string();
@@ -312,13 +299,10 @@ void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, co
 // --drops, --mode, --spheres, --seed: the design of the ensemble.
 void apply_design_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
-  if (given("--drops")) {
-    e.drops = parse_count("--drops", r.drops, 1, kMaxStreamingDrops);  // > 2^31: streaming only (validate)
-    if (k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
-  }
+  if (given("--drops") && k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
   if (given("--mode")) apply_mode_option(scene, r, given, k);
   if (given("--spheres")) {
-    e.spheres = parse_count("--spheres", r.spheres, 1, kMaxRawDrops);
+    e.spheres = count_option(r, "--spheres");
     scene.spheres_auto = false;
     if ((k.bounce && !k.mesh) || k.radii)
       refuse("--spheres", "not used by " + k.text + (k.radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
@@ -326,21 +310,20 @@ void apply_design_options(Scene& scene, const RawOptions& r, const Given& given,
       refuse("--spheres", "only for the explicit design (explicit spheres x rotations); sampled drops build no sphere: "
                           "add --mode explicit");
   }
-  if (given("--seed")) e.seed = parse_count("--seed", r.seed, 0, ~std::uint64_t{0});
 }
 
 // --speed, --omega-x, --omega-y: the impact (a mesh body's bounce takes the spin as its start).
 void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
   if (given("--speed")) {
-    const double u = parse_positive("--speed", r.speed, "m/s");
+    const double u = parse_positive("--speed", r["--speed"], "m/s");
     if (k.radii) refuse("--speed", k.text + " is analysed as contacts only (no impacts)");
     e.impact.enabled = true;
     scene.restitution_stats = true;
     e.impact.speed = u;
   }
-  if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", r.omega_x);
-  if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", r.omega_y);
+  if (given("--omega-x")) e.impact.omega.x() = parse_real("--omega-x", r["--omega-x"]);
+  if (given("--omega-y")) e.impact.omega.y() = parse_real("--omega-y", r["--omega-y"]);
   if (!given("--omega-x") && !given("--omega-y")) return;
   const std::string opt = given("--omega-x") ? "--omega-x" : "--omega-y";
   if (k.bounce && k.mesh) {  // a mesh body's bounce starts with experiment.Omega
@@ -354,10 +337,8 @@ void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given,
     refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
 }
 
-void apply_backend_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
-  auto& e = scene.ensemble;
-  e.backend = parse_backend(r.backend);
-  scene.backend_auto = false;
+void apply_backend_option(const Scene& scene, const OptionKind& k) {
+  const auto& e = scene.ensemble;
   if (k.bounce || k.mesh || k.radii)
     refuse("--backend", "not used by " + k.text + (k.bounce ? "" : ", which queries the exact support tree"));
   if (e.mode != Mode::explicit_spheres)
@@ -388,74 +369,30 @@ void apply_bounce_options(Scene& scene, const RawOptions& r, const Given& given)
   if (!scene.bounce.enabled) return;
   auto& e = scene.ensemble;
   if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
-  if (given("--sequences")) scene.bounce.sequences = parse_count("--sequences", r.sequences, 1, kMaxRawDrops);
-  if (given("--variant")) scene.bounce.variants = parse_variants(r.variants);
+  if (given("--sequences")) scene.bounce.sequences = count_option(r, "--sequences");
+  if (given("--variant")) scene.bounce.variants = parse_variants(r["--variant"]);
 }
 
-// --tangential MODEL[:KEY=VALUE[,KEY=VALUE]] (material.tangential of scenes): every key once, each
-// known to its model, the model's required keys given; a bad one is named with the whole value.
-TangentialLaw parse_tangential(const std::string& text) {
-  const std::string opt = "--tangential";
-  auto bad = [&](const std::string& why) { return BadInput(opt + ": '" + text + "' " + why); };
+// --tangential MODEL[:KEY=VALUE[,KEY=VALUE]]: the items of material.tangential, which its one reader
+// checks (scene_file.hpp); a value in decimal notation is a number, any other a name.
+TangentialLaw tangential_option(const std::string& text) {
   const std::size_t colon = text.find(':');
-  const std::string model = text.substr(0, colon);
-  std::map<std::string, std::string> kv;
-  if (colon != std::string::npos) {
-    std::size_t pos = colon + 1;
-    do {
-      const std::size_t comma = text.find(',', pos);
-      const std::string item = text.substr(pos, comma - pos);
-      const std::size_t eq = item.find('=');
-      if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
-        throw bad("has '" + item + "' where KEY=VALUE belongs (e.g. coulomb:mu=0.3,restitution=energetic)");
-      if (!kv.emplace(item.substr(0, eq), item.substr(eq + 1)).second) throw bad("gives " + item.substr(0, eq) + " twice");
-      pos = comma == std::string::npos ? comma : comma + 1;
-    } while (pos != std::string::npos);
+  std::vector<OptionItem> items{{"model", text.substr(0, colon), std::nullopt}};
+  for (std::size_t pos = colon; pos != std::string::npos;) {
+    const std::size_t comma = text.find(',', pos + 1);
+    const std::string item = text.substr(pos + 1, comma - pos - 1);
+    const std::size_t eq = item.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+      throw BadInput("--tangential: '" + text + "' has '" + item + "' where KEY=VALUE belongs (e.g. coulomb:mu=0.3,restitution=energetic)");
+    const std::string value = item.substr(eq + 1);
+    items.push_back({item.substr(0, eq), value, decimal_syntax(value) ? std::optional(parse_real("--tangential", value)) : std::nullopt});
+    pos = comma;
   }
-  std::vector<std::string> keys;  // the model's keys, for the check of unknown ones
-  auto real = [&](const std::string& key, bool required) -> std::optional<double> {
-    keys.push_back(key);
-    const auto it = kv.find(key);
-    if (it == kv.end()) {
-      if (required) throw bad("needs " + key + "=VALUE for model " + model);
-      return std::nullopt;
-    }
-    return parse_real(opt + " " + key, it->second);
-  };
-  TangentialLaw law;
-  if (model == "kinematic") {
-    law = TangentialLaw::kinematic(real("eps_t", false).value_or(1.0));
-    if (law.eps_t < -1 || law.eps_t > 1) throw bad("has eps_t outside [-1, 1]");
-  } else if (model == "coulomb") {
-    const double mu = *real("mu", true);
-    keys.push_back("restitution");
-    const auto it = kv.find("restitution");
-    if (it == kv.end()) throw bad("needs restitution=newton|poisson|energetic for model coulomb");
-    try {
-      law = TangentialLaw::coulomb(mu, parse_normal_rule(it->second));
-    } catch (const std::invalid_argument&) {
-      throw bad("has restitution=" + it->second + " (known: newton, poisson, energetic)");
-    }
-  } else if (model == "stronge") {
-    law = TangentialLaw::stronge(*real("mu", true));
-  } else if (model == "walton") {
-    const double mu = *real("mu", true);
-    law = TangentialLaw::walton(mu, *real("beta0", true));
-  } else {
-    throw bad("has model '" + model + "' (known: kinematic, coulomb, stronge, walton)");
-  }
-  for (const auto& [k, v] : kv)
-    if (std::find(keys.begin(), keys.end(), k) == keys.end()) throw bad("has " + k + "=" + v + ", not a key of model " + model);
-  try {
-    validate(law);
-  } catch (const std::invalid_argument& ex) {
-    throw bad(ex.what());
-  }
-  return law;
+  return read_tangential_items(items, "--tangential");
 }
 
 void apply_tangential_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
-  const TangentialLaw law = parse_tangential(r.tangential);
+  const TangentialLaw law = tangential_option(r["--tangential"]);
   if (k.radii) refuse("--tangential", k.text + " is analysed as contacts only (no impacts)");
   auto& x = scene.ensemble.impact;
   if (!x.enabled && !scene.bounce.enabled)
@@ -467,16 +404,12 @@ void apply_tangential_option(Scene& scene, const RawOptions& r, const OptionKind
 }
 
 // --statistics, --bins-log2 (sphere contact runs), --checkpoint-every (streaming runs).
-void apply_streaming_options(Scene& scene, RunControl& control, const RawOptions& r, const Given& given,
-                             const OptionKind& k) {
-  auto& e = scene.ensemble;
+void apply_streaming_options(RunControl& control, const RawOptions& r, const Given& given, const OptionKind& k) {
   if (given("--checkpoint-every")) {
-    control.checkpoint_seconds = parse_real("--checkpoint-every", r.checkpoint_every);
+    control.checkpoint_seconds = parse_real("--checkpoint-every", r["--checkpoint-every"]);
     if (!(control.checkpoint_seconds >= 0) || !std::isfinite(control.checkpoint_seconds))
-      throw BadInput("--checkpoint-every: '" + r.checkpoint_every + "' must be a finite number of seconds >= 0");
+      throw BadInput("--checkpoint-every: '" + r["--checkpoint-every"] + "' must be a finite number of seconds >= 0");
   }
-  if (given("--statistics")) e.statistics = parse_statistics(r.statistics);
-  if (given("--bins-log2")) e.bins_log2 = static_cast<unsigned>(parse_count("--bins-log2", r.bins_log2, 10, 24));
   if ((given("--statistics") || given("--bins-log2")) && (k.bounce || k.mesh || k.radii))
     refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
 }
@@ -484,72 +417,87 @@ void apply_streaming_options(Scene& scene, RunControl& control, const RawOptions
 // --kernel: the drop kernel of explicit sphere drops. It changes no bit, so it may come with
 // --resume; validate() refuses one this build lacks.
 void apply_kernel_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
-  scene.ensemble.kernel = parse_kernel(r.kernel);
+  scene.ensemble.kernel = parse_kernel(r["--kernel"]);
   if (k.bounce || k.mesh || k.radii) refuse("--kernel", "not used by " + k.text + " (explicit sphere drops only)");
   if (scene.ensemble.mode != Mode::explicit_spheres)
     refuse("--kernel", "only for the explicit design (explicit spheres); sampled drops run no drop kernel: add --mode explicit");
 }
 
-// --resume DIR: the checkpoint's own scene; only options that change no result may come with it.
+// --resume DIR: the checkpoint's own scene; only options that change no result (their rows) may
+// come with it.
 void check_resume_option(const RawOptions& r, const Given& given) {
-  for (const char* o : {"--scene", "--asperities", "--radius", "--asperity-radius", "--drops", "--mode", "--spheres",
-                        "--seed", "--backend", "--alpha", "--out", "--speed", "--omega-x", "--omega-y", "--variant",
-                        "--sequences", "--statistics", "--bins-log2", "--tangential"})
-    if (given(o))
-      throw BadInput(std::string(o) + ": --resume continues the checkpoint's own scene; only --threads, --kernel, "
-                                      "--quiet, --no-plots and --checkpoint-every may be given with it");
-  if (r.resume.empty()) throw BadInput("--resume: '' is not a directory name");
+  for (const OptionRow& row : option_rows())
+    if (row.changes_result && given(std::string(long_flag(row)).c_str()))
+      throw BadInput(std::string(long_flag(row)) + ": --resume continues the checkpoint's own scene; only " +
+                     result_free_options() + " may be given with it");
+  if (r["--resume"].empty()) throw BadInput("--resume: '' is not a directory name");
 }
 
 // --threads, --alpha, --no-plots, --out; and the scene's name says when options changed the physics.
 void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
-  if (given("--threads")) {
-    const std::uint64_t t = parse_count("--threads", r.threads, 0, std::uint64_t(kMaxThreads));
-    scene.ensemble.threads = static_cast<int>(t);
-  }
-  if (given("--alpha")) {
-    const double a = parse_real("--alpha", r.alpha);
-    if (!(a > 0 && a < 1)) throw BadInput("--alpha: '" + r.alpha + "' must be in (0, 1)");
-    if (scene.bounce.enabled)
-      throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
-                     "decide nothing (exit status 0)");
-    scene.alpha = a;
-  }
+  if (given("--alpha") && scene.bounce.enabled)
+    throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
+                   "decide nothing (exit status 0)");
   if (r.no_plots) scene.plots = false;
   if (given("--plot-format")) {
     try {
-      parse_plot_formats(r.plot_format);
+      parse_plot_formats(r["--plot-format"]);
     } catch (const std::invalid_argument& ex) {
       throw BadInput(std::string("--plot-format: ") + ex.what());
     }
-    scene.plot_format = r.plot_format;
+    scene.plot_format = r["--plot-format"];
   }
   if (given("--out")) {
-    if (r.out.empty()) throw BadInput("--out: '' is not a directory name");
-    scene.out = r.out;
+    if (r["--out"].empty()) throw BadInput("--out: '' is not a directory name");
+    scene.out = r["--out"];
   }
-  if (!given("--scene") && !given("--resume") && r.preset_name != scene.name) scene.name = r.preset_name;
+  if (!given("--scene") && !given("--resume") && r["--preset"] != scene.name) scene.name = r["--preset"];
   if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
       given("--speed") || given("--omega-x") || given("--omega-y") || given("--tangential"))
     scene.name += "+custom";
+}
+
+// An option's text as the value a scene file would hold, for the reader to check: a whole number as
+// an integer (a seed above 2^63 - 1 as its digits, as scene files write it), another number as a
+// float, any other text as a string.
+// A float goes through parse_real: a value beyond a double's normal range is named as written.
+std::variant<std::int64_t, double, std::string> scene_value(const std::string& flag, const std::string& text) {
+  if (!decimal_syntax(text)) return text;
+  const long double v = std::strtold(text.c_str(), nullptr);
+  if (v == std::floor(v) && text[0] == '+') return text;  // whole numbers are written without a sign
+  if (v == std::floor(v) && std::fabs(v) < 0x1p63L) return static_cast<std::int64_t>(v);
+  if (flag == "--seed" && text.find_first_not_of("0123456789") == std::string::npos) return text;
+  return parse_real(flag, text);
+}
+
+// The options that are edits of one scene key (their rows' target), read with the scene.
+std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
+  std::vector<SceneEdit> edits;
+  for (const char* flag : {"--asperities", "--drops", "--seed", "--backend", "--threads", "--statistics", "--bins-log2", "--alpha"})
+    if (given(flag))
+      edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag]),
+                       std::string_view(flag) == "--asperities" ? "areal_density" : ""});
+  return edits;
 }
 
 // The preset or scene file, then the options over it (docs/scenes.md), in this order: the kind of
 // run is taken after --asperity-radius, which can turn a radii run into the paper's.
 Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoader& load, RunControl& control) {
   if (given("--resume")) check_resume_option(r, given);
-  const std::string path = given("--resume") ? (std::filesystem::path(r.resume) / "checkpoint.toml").string() : r.scene_file;
-  Scene scene = !given("--scene") && !given("--resume") ? preset(r.preset_name) : load ? load(path) : load_scene(path);
-  if (given("--resume")) scene.out = r.resume, control.resume = true;
+  const std::string path = given("--resume") ? (std::filesystem::path(r["--resume"]) / "checkpoint.toml").string() : r["--scene"];
+  const std::vector<SceneEdit> edits = scene_edits(r, given);
+  Scene scene = !given("--scene") && !given("--resume") ? preset(r["--preset"], edits) : load ? load(path, edits)
+                                                                                        : load_scene(path, edits);
+  if (given("--resume")) scene.out = r["--resume"], control.resume = true;
   apply_body_options(scene, r, given);
   const OptionKind k = option_kind(scene);
   apply_design_options(scene, r, given, k);
   apply_impact_options(scene, r, given, k);
-  if (given("--backend")) apply_backend_option(scene, r, k);
+  if (given("--backend")) apply_backend_option(scene, k);
   if (given("--kernel")) apply_kernel_option(scene, r, k);
   apply_bounce_options(scene, r, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
-  apply_streaming_options(scene, control, r, given, k);
+  apply_streaming_options(control, r, given, k);
   apply_run_options(scene, r, given);
   return scene;  // the cross-key rules: plan() (plan.hpp), once per run
 }

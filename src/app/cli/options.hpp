@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "asperity/app/plan.hpp"
+#include "asperity/app/scene_file.hpp"
 
 namespace asperity::cli {
 
@@ -31,8 +32,9 @@ struct Options {
 /// Parses the arguments after the program name. Throws BadInput (and only BadInput) for any bad
 /// option or value: unknown options, malformed/non-finite/out-of-range numbers, options that do not
 /// apply to the scene's kind of run. The scene's cross-key rules are checked once, by plan(). No files are written; `--scene FILE` is read through `load` (load_scene by default;
-/// the fuzz target passes its own, so that fuzzing never touches the file system).
-using SceneLoader = std::function<Scene(const std::string& file)>;
+/// the fuzz target passes its own, so that fuzzing never touches the file system). `edits`: the
+/// options that set one scene key, applied before the file is read (scene_file.hpp).
+using SceneLoader = std::function<Scene(const std::string& file, const std::vector<SceneEdit>& edits)>;
 Options parse_command_line(std::span<const std::string> args, const SceneLoader& load = {});
 
 }  // namespace asperity::cli
