@@ -3,7 +3,7 @@
 // time, and SIMD, kW drops per vector with GCC vector types, one body compiled for avx512f, avx2
 // and SSE2 (the x86-64 baseline), chosen once from the CPU (detail::best_isa). Both call the same inline functions; vector
 // lanes perform the same IEEE operations in the same order as the scalar code, so the bits agree.
-// Rejected disk attempts (~21 % per disk) are finished lane by lane by the scalar code.
+// One Philox block per drop, no rejection: every lane of a vector is a drop.
 #include "asperity/core/drop_kernel.hpp"
 
 #include "core/drop_kernel_detail.hpp"
@@ -90,55 +90,47 @@ using u32v = std::uint32_t __attribute__((vector_size(4 * kW)));
 using i32v = std::int32_t __attribute__((vector_size(4 * kW)));
 using f64v = double __attribute__((vector_size(8 * kW)));
 
-// Philox's mulhilo for 32-bit lanes. With a 32-bit vector multiply (avx2, avx512f): hi by the
-// widening multiply of even and odd lanes, lo by vpmulld (one loop computing both made GCC pack the
-// products: 4x the instructions). SSE2 has no vpmulld: there the one loop is the shorter.
-template <bool Mul32>
+using u64v = std::uint64_t __attribute__((vector_size(4 * kW)));  // the same bits as u32v, pairs of lanes
+using i64v = std::int64_t __attribute__((vector_size(8 * kW)));
+
+// The vector lanes of the kernel's inline functions: Philox's mulhilo and the int -> double
+// conversion. The high words by the widening multiply of the even and of the odd 32-bit lanes
+// (u32v read as u64v pairs: (a & 0xffffffff) m and (a >> 32) m are vpmuludq / pmuludq), put back in
+// place by a shift and a mask; the low words by the 32-bit multiply. One source for every target
+// (avx512f, avx2, SSE2): plain GCC vector arithmetic, no intrinsics.
 struct VectorLanes {
   [[gnu::always_inline]] void operator()(u32v a, std::uint32_t m, u32v& hi, u32v& lo) const {
-    if constexpr (Mul32) {
-      for (std::size_t l = 0; l < kW; ++l) hi[l] = static_cast<std::uint32_t>((static_cast<std::uint64_t>(a[l]) * m) >> 32);
-      lo = a * m;
-    } else {
-      for (std::size_t l = 0; l < kW; ++l) {
-        const std::uint64_t p = static_cast<std::uint64_t>(a[l]) * m;
-        hi[l] = static_cast<std::uint32_t>(p >> 32), lo[l] = static_cast<std::uint32_t>(p);
-      }
-    }
+    const u64v w = reinterpret_cast<u64v>(a), M = u64v{} + m;
+    const u64v even = ((w & 0xFFFFFFFFu) * M) >> 32, odd = ((w >> 32) * M) & 0xFFFFFFFF00000000u;
+    hi = reinterpret_cast<u32v>(even | odd);
+    lo = a * m;
   }
   [[gnu::always_inline]] f64v operator()(i32v x) const { return __builtin_convertvector(x, f64v); }
-  [[gnu::always_inline]] void philox(u32v (&c)[4], std::uint32_t k0, std::uint32_t k1) const {
-    kernel::philox4x32_10(c, k0, k1, *this);
+};
+// With AVX2 the high words by one primitive: vpmuludq on the even and on the odd lanes, blended
+// (GCC turns the u64 products above into shift-and-add sequences for the constant multipliers:
+// ~3x the instructions). Only this primitive differs; Philox itself is the shared philox4x32_10.
+// Not always_inline: GCC refuses to force an avx2 function into the default-target philox4x32_10;
+// it inlines it once that one sits in the avx2 and avx512f clones (checked: no call in their code).
+struct Avx2Lanes : VectorLanes {
+  using VectorLanes::operator();
+  __attribute__((target("avx2"))) void operator()(u32v a, std::uint32_t m, u32v& hi, u32v& lo) const {
+    const __m256i x = reinterpret_cast<__m256i>(a), M = _mm256_set1_epi32(static_cast<int>(m));
+    const __m256i even = _mm256_srli_epi64(_mm256_mul_epu32(x, M), 32);
+    const __m256i odd = _mm256_mul_epu32(_mm256_srli_epi64(x, 32), M);
+    hi = reinterpret_cast<u32v>(_mm256_blend_epi32(even, odd, 0xAA));
+    lo = a * m;
   }
 };
-
-// Philox4x32-10 on eight lanes with AVX2 intrinsics: the same operations as philox4x32_10 (the test
-// compares every variant with the scalar reference bit for bit), but hi without packing: vpmuludq on
-// the even and on the odd lanes, the high words blended into place (~18 instead of ~46 instructions
-// per round). Out of line: a function of another target cannot be inlined into the generic templates.
-__attribute__((target("avx2"))) void philox_avx2(u32v (&c)[4], std::uint32_t k0, std::uint32_t k1) {
-  __m256i x[4];
-  std::memcpy(x, c, sizeof x);
-  const __m256i m0 = _mm256_set1_epi32(static_cast<int>(0xD2511F53u)), m1 = _mm256_set1_epi32(static_cast<int>(0xCD9E8D57u));
-  auto mulhi = [](__m256i a, __m256i m) __attribute__((target("avx2"))) {
-    const __m256i even = _mm256_srli_epi64(_mm256_mul_epu32(a, m), 32);
-    const __m256i odd = _mm256_mul_epu32(_mm256_srli_epi64(a, 32), m);
-    return _mm256_blend_epi32(even, odd, 0xAA);
-  };
-  for (int r = 0; r < 10; ++r) {
-    const __m256i hi0 = mulhi(x[0], m0), lo0 = _mm256_mullo_epi32(x[0], m0);
-    const __m256i hi1 = mulhi(x[2], m1), lo1 = _mm256_mullo_epi32(x[2], m1);
-    const __m256i key0 = _mm256_set1_epi32(static_cast<int>(k0)), key1 = _mm256_set1_epi32(static_cast<int>(k1));
-    x[0] = _mm256_xor_si256(_mm256_xor_si256(hi1, x[1]), key0);
-    x[1] = lo1;
-    x[2] = _mm256_xor_si256(_mm256_xor_si256(hi0, x[3]), key1);
-    x[3] = lo0;
-    k0 += 0x9E3779B9u, k1 += 0xBB67AE85u;
+// mask ? a : b on double lanes, the mask a comparison of 32-bit lanes (0 or all ones), widened to
+// 64 bits by sign extension and applied as and/andnot/or: the same bits as a lane-wise ?: (issue 39:
+// `m != 0 ? a : b` on 8-double vectors compiled to per-lane branches under AVX2, 59 of the draw's
+// 122 instructions per drop).
+struct VectorSel {
+  [[gnu::always_inline]] f64v operator()(i32v m, f64v a, f64v b) const {
+    const i64v w = __builtin_convertvector(m, i64v);
+    return reinterpret_cast<f64v>((w & reinterpret_cast<i64v>(a)) | (~w & reinterpret_cast<i64v>(b)));
   }
-  std::memcpy(c, x, sizeof x);
-}
-struct Avx2Lanes : VectorLanes<true> {
-  void philox(u32v (&c)[4], std::uint32_t k0, std::uint32_t k1) const { philox_avx2(c, k0, k1); }
 };
 struct VectorSqrt {
   // Lane by lane; GCC emits the vector sqrt (IEEE, correctly rounded) given -fno-math-errno and
@@ -151,45 +143,25 @@ struct VectorSqrt {
   }
 };
 
-struct Disk {
-  f64v x, y, s;
-};
-
-// First attempts of disk w for drops first .. first + kW - 1, rejected lanes finished by the scalar code.
-template <class Lanes>
-[[gnu::always_inline]] inline Disk disk_lanes(std::uint64_t seed, std::uint64_t first, std::uint32_t w) {
-  // Counter (index lo, index hi, w, purpose) of drops first + l: the low words with their carry.
-  const u32v zero = {}, iota = {0, 1, 2, 3, 4, 5, 6, 7};
-  const auto lo0 = static_cast<std::uint32_t>(first);
-  const u32v lo = zero + lo0 + iota;
-  const u32v wrapped = reinterpret_cast<u32v>(lo < lo0);  // all ones where the low word wrapped
-  u32v c[4] = {lo, zero + static_cast<std::uint32_t>(first >> 32) - wrapped, zero + w, zero + kernel::kPurposeDrop};
-  const Lanes L;
-  L.philox(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32));
-  const u32v flip = c[1] ^ 0x80000000u, flip3 = c[3] ^ 0x80000000u;
-  Disk k;
-  k.x = kernel::coordinate<f64v>(reinterpret_cast<i32v>(c[0]), reinterpret_cast<i32v>(flip), L);
-  k.y = kernel::coordinate<f64v>(reinterpret_cast<i32v>(c[2]), reinterpret_cast<i32v>(flip3), L);
-  k.s = k.x * k.x + k.y * k.y;
-  const auto ok = (k.s < 1.0) & (k.s > 0.0);
-  for (std::size_t l = 0; l < kW; ++l)
-    if (!ok[l]) {
-      double x, y, s;
-      kernel::disk_from(seed, first + l, w, 1, x, y, s);
-      k.x[l] = x, k.y[l] = y, k.s[l] = s;
-    }
-  return k;
-}
-
+// Drops first .. first + n - 1, kW per step: one Philox block per drop (counter (index lo, index hi,
+// 0, purpose), the low words with their carry), then drop_from_block, as draw_one does lane by lane.
 template <class Lanes, class Sqrt>
 [[gnu::always_inline]] inline void draw_simd(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
   const std::size_t n = d.size();
+  const u32v zero = {}, iota = {0, 1, 2, 3, 4, 5, 6, 7};
+  const Lanes L;
   for (std::size_t i = 0; i < n; i += kW) {
     // A tail shorter than kW computes whole vectors and stores its lanes only.
-    const Disk p = disk_lanes<Lanes>(seed, first + i, 0), q = disk_lanes<Lanes>(seed, first + i, 1);
+    const std::uint64_t f = first + i;
+    const auto lo0 = static_cast<std::uint32_t>(f);
+    const u32v lo = zero + lo0 + iota;
+    const u32v wrapped = reinterpret_cast<u32v>(lo < lo0);  // all ones where the low word wrapped
+    u32v w[4] = {lo, zero + static_cast<std::uint32_t>(f >> 32) - wrapped, zero, zero + kernel::kPurposeDrop};
+    kernel::philox4x32_10(w, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L);
     f64v dx, dy, dz, cc, sn;
-    kernel::sphere_point(p.x, p.y, p.s, dx, dy, dz, Sqrt{});
-    kernel::azimuth(q.x, q.y, q.s, cc, sn, Sqrt{});
+    kernel::drop_from_block<f64v>(reinterpret_cast<i32v>(w[0]), reinterpret_cast<i32v>(w[1] ^ 0x80000000u),
+                                  reinterpret_cast<i32v>(w[2]), reinterpret_cast<i32v>(w[3]), dx, dy, dz, cc, sn, L,
+                                  VectorSel{}, Sqrt{});
     for (std::size_t l = 0; l < kW && i + l < n; ++l) {
       d[i + l] = Vec3(dx[l], dy[l], dz[l]);
       c[i + l] = cc[l], s[i + l] = sn[l];
@@ -234,7 +206,7 @@ __attribute__((target("avx2"))) void draw_avx2(std::uint64_t seed, std::uint64_t
   draw_simd<Avx2Lanes, VectorSqrt>(seed, first, d, c, s);
 }
 void draw_sse2(std::uint64_t seed, std::uint64_t first, std::span<Vec3> d, std::span<double> c, std::span<double> s) {
-  draw_simd<VectorLanes<false>, VectorSqrt>(seed, first, d, c, s);
+  draw_simd<VectorLanes, VectorSqrt>(seed, first, d, c, s);
 }
 __attribute__((target("avx512f"))) void contacts_avx512(std::span<const Vec3> d, std::span<const double> c,
                                                         std::span<const double> s, std::span<const Nearest> nn,
@@ -292,7 +264,7 @@ namespace detail {
 bool isa_available(SimdIsa isa) {
 #if ASPERITY_DROP_SIMD
   switch (isa) {
-    case SimdIsa::avx512f: return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2");  // its Philox is AVX2's
+    case SimdIsa::avx512f: return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx2");  // its mulhi is AVX2's
     case SimdIsa::avx2: return __builtin_cpu_supports("avx2");
     case SimdIsa::sse2: return true;
     case SimdIsa::none: return true;

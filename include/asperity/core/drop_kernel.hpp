@@ -11,14 +11,14 @@
 // contact point is phi plus an angle that depends on d only, hence uniform and independent of d,
 // so (r_x, r_y) = r_xy (c, s) has the law the full rotation gives, without rotating anything.
 //
-// Streams without transcendental functions: Marsaglia's disk method (Ann. Math. Statist. 43 (1972)
-// 645) for d -- (x, y) uniform in the unit disk by rejection, s = x^2 + y^2, then
-// d = (2 x sqrt(1 - s), 2 y sqrt(1 - s), 1 - 2 s) -- and a second disk point, normalised, for the
-// azimuth. Attempt a of disk w (0: direction, 1: azimuth) is the Philox4x32-10 block with counter
-// (index lo, index hi, 2 a + w, Purpose::drop) and key (seed lo, seed hi), so every thread, rank or
-// resumed run draws the same bits. Only +, -, *, / and sqrt (IEEE, correctly rounded; no FMA
-// contraction: -ffp-contract=off here, nvcc -fmad=false), so every instantiation gives the same
-// bits.
+// One Philox4x32-10 block per drop, no rejection (issue 30): counter (index lo, index hi, 0,
+// Purpose::drop), key (seed lo, seed hi), so every thread, rank or resumed run draws the same bits.
+// Its words (w0, w1, w2, w3) give z = w0 2^-31 + w1 2^-63 uniform on [-1, 1) (64 bits rounded to
+// 53), the direction's longitude 2 pi w2 2^-32 and the azimuth 2 pi w3 2^-32: d = (rho cos, rho
+// sin, z), rho = sqrt((1 - z)(1 + z)), uniform on the sphere (Archimedes). sin and cos are
+// polynomials after an exact quadrant split (kernel::sincos_turn). Only +, -, * and sqrt (IEEE,
+// correctly rounded; no FMA contraction: -ffp-contract=off here, nvcc -fmad=false), so every
+// instantiation gives the same bits.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -41,9 +41,9 @@ bool kernel_available(Kernel k);
 
 /// One drop's draw: the body-frame down direction and the world azimuth.
 struct DropDraw {
-  Vec3 d;  ///< unit down direction in the body frame (Marsaglia's disk method)
+  Vec3 d;  ///< unit down direction in the body frame (z and longitude from one Philox block)
   ///@{
-  /// cos and sin of the world azimuth (a normalised disk point): (r_x, r_y) = r_xy (c, s).
+  /// cos and sin of the world azimuth (polynomial, kernel::sincos_turn): (r_x, r_y) = r_xy (c, s).
   double c = 1, s = 0;
   ///@}
 };

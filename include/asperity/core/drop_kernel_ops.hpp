@@ -45,18 +45,48 @@ ASPERITY_HD_INLINE D coordinate(I32 hi, I32 lo_flipped, ToD to_d) {
   return to_d(hi) * 0x1p-31 + (to_d(lo_flipped) + 2147483648.0) * 0x1p-63;
 }
 
-/// Marsaglia's map from a disk point (x, y), s = x^2 + y^2 in (0, 1), to the unit sphere.
-template <class D, class Sqrt>
-ASPERITY_HD_INLINE void sphere_point(D x, D y, D s, D& dx, D& dy, D& dz, Sqrt sq) {
-  const D f = 2.0 * sq(1.0 - s);
-  dx = x * f, dy = y * f, dz = 1.0 - 2.0 * s;
+/// sin and cos of the angle 2 pi w 2^-32 (w a 32-bit word read as signed), by polynomials in a fixed
+/// operation order (+, -, * only), so that scalar, SIMD and CUDA give the same bits. The quadrant q
+/// = round(w / 2^30) is split off in integers (exact), r = w - q 2^30 in [-2^29, 2^29] becomes x =
+/// 2 pi r 2^-32 in [-pi/4, pi/4), and sin x, cos x are their Taylor polynomials to x^15 and x^16
+/// (truncation < 7e-17 relative; a few ulp in all), then rotated by q quarter turns. I32: signed lanes; Sel:
+/// sel(mask, a, b) lane-wise, mask from a comparison of I32 lanes.
+template <class D, class I32, class ToD, class Sel>
+ASPERITY_HD_INLINE void sincos_turn(I32 w, D& sn, D& cs, ToD to_d, Sel sel) {
+  // w = q 2^30 + r, r in [-2^29, 2^29): r is w mod 2^30 moved into that range (no overflow anywhere).
+  const I32 low = w & 0x3FFFFFFF;
+  const I32 r = low - ((low & 0x20000000) << 1);
+  const I32 q = ((w >> 29) + 1) >> 1;  // arithmetic shifts: round(w / 2^30), ties up; mod 4 below
+  const D x = to_d(r) * 1.4629180792671596e-09;                      // 2 pi / 2^32
+  const D x2 = x * x;
+  const D ps = ((((((-7.6471637318198164759e-13 * x2 + 1.6059043836821614599e-10) * x2 - 2.5052108385441718775e-08) * x2 +
+                   2.7557319223985890653e-06) * x2 - 1.9841269841269841270e-04) * x2 + 8.3333333333333333333e-03) * x2 -
+                0.16666666666666666667) * x2;
+  const D s0 = x + x * ps;
+  const D pc = (((((((4.7794773323873852974e-14 * x2 - 1.1470745597729724714e-11) * x2 + 2.0876756987868098979e-09) * x2 -
+                    2.7557319223985890653e-07) * x2 + 2.4801587301587301587e-05) * x2 - 1.3888888888888888889e-03) * x2 +
+                 4.1666666666666666667e-02) * x2 - 0.5) * x2;
+  const D c0 = 1.0 + pc;
+  // Quarter turns (q mod 4): 1: (sin, cos) = (c0, -s0); 2: (-s0, -c0); 3: (-c0, s0).
+  const I32 odd = q & 1, neg_s = q & 2, neg_c = (q + 1) & 2;
+  const D a = sel(odd != 0, c0, s0), b = sel(odd != 0, s0, c0);
+  sn = sel(neg_s != 0, -a, a);
+  cs = sel(neg_c != 0, -b, b);
 }
 
-/// The world azimuth (c, s) from a disk point: the point normalised.
-template <class D, class Sqrt>
-ASPERITY_HD_INLINE void azimuth(D x, D y, D s, D& c, D& sn, Sqrt sq) {
-  const D r = sq(s);
-  c = x / r, sn = y / r;
+/// A drop from its one Philox4x32-10 block (w0, w1, w2, w3): z = coordinate(w0, w1) uniform on [-1,
+/// 1) (64 bits, rounded to 53), the direction's longitude 2 pi w2 2^-32 and the world azimuth 2 pi
+/// w3 2^-32, so d = (rho cos, rho sin, z) with rho = sqrt((1 - z)(1 + z)) is uniform on the sphere
+/// (Archimedes) and independent of the azimuth (c, sn). No rejection: one block per drop.
+template <class D, class I32, class ToD, class Sel, class Sqrt>
+ASPERITY_HD_INLINE void drop_from_block(I32 w0, I32 w1_flipped, I32 w2, I32 w3, D& dx, D& dy, D& dz, D& c, D& sn, ToD to_d,
+                                        Sel sel, Sqrt sq) {
+  dz = coordinate<D>(w0, w1_flipped, to_d);
+  const D rho = sq((1.0 - dz) * (1.0 + dz));
+  D s2, c2;
+  sincos_turn<D>(w2, s2, c2, to_d, sel);
+  dx = rho * c2, dy = rho * s2;
+  sincos_turn<D>(w3, sn, c, to_d, sel);
 }
 
 /// The contact quantities of one drop whose lowest asperity has centre u (unit) and key k = |u - d|^2,
@@ -94,34 +124,22 @@ struct ScalarSqrt {
 #endif
 };
 
-/// Attempt `sub` = 2 a + w (attempt a of disk w) of drop `index`: a point in [-1, 1)^2 and its s;
-/// true when 0 < s < 1 (inside the open disk, not the origin: the azimuth divides by sqrt(s)).
-ASPERITY_HD_INLINE bool disk_attempt(std::uint64_t seed, std::uint64_t index, std::uint32_t sub, double& x, double& y,
-                                     double& s) {
-  std::uint32_t c[4] = {static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32), sub, kPurposeDrop};
-  const ScalarLanes L;
-  philox4x32_10(c, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L);
-  x = coordinate<double>(static_cast<std::int32_t>(c[0]), static_cast<std::int32_t>(c[1] ^ 0x80000000u), L);
-  y = coordinate<double>(static_cast<std::int32_t>(c[2]), static_cast<std::int32_t>(c[3] ^ 0x80000000u), L);
-  s = x * x + y * y;
-  return s < 1.0 && s > 0.0;
-}
+/// The scalar select (the lanes' `mask ? a : b`).
+struct ScalarSel {
+  /// m ? a : b.
+  ASPERITY_HD_INLINE double operator()(bool m, double a, double b) const { return m ? a : b; }
+};
 
-/// Disk w of drop `index` from attempt a0 on (rejection: 1 - pi/4 of the attempts fail).
-ASPERITY_HD_INLINE void disk_from(std::uint64_t seed, std::uint64_t index, std::uint32_t w, std::uint32_t a0, double& x,
-                                  double& y, double& s) {
-  for (std::uint32_t a = a0;; ++a)
-    if (disk_attempt(seed, index, 2 * a + w, x, y, s)) return;
-}
-
-/// One drop by the scalar reference: down direction d and azimuth (c, sn).
+/// One drop by the scalar reference: down direction d and azimuth (c, sn), from the Philox4x32-10
+/// block with counter (index lo, index hi, 0, kPurposeDrop) and key (seed lo, seed hi).
 ASPERITY_HD_INLINE void draw_one(std::uint64_t seed, std::uint64_t index, double& dx, double& dy, double& dz, double& c,
                                  double& sn) {
-  double x, y, s;
-  disk_from(seed, index, 0, 0, x, y, s);
-  sphere_point(x, y, s, dx, dy, dz, ScalarSqrt{});
-  disk_from(seed, index, 1, 0, x, y, s);
-  azimuth(x, y, s, c, sn, ScalarSqrt{});
+  std::uint32_t w[4] = {static_cast<std::uint32_t>(index), static_cast<std::uint32_t>(index >> 32), 0u, kPurposeDrop};
+  const ScalarLanes L;
+  philox4x32_10(w, static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32), L);
+  drop_from_block<double>(static_cast<std::int32_t>(w[0]), static_cast<std::int32_t>(w[1] ^ 0x80000000u),
+                          static_cast<std::int32_t>(w[2]), static_cast<std::int32_t>(w[3]), dx, dy, dz, c, sn, L,
+                          ScalarSel{}, ScalarSqrt{});
 }
 
 }  // namespace kernel
