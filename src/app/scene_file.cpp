@@ -655,19 +655,20 @@ void read_screening(Reader& top, Scene& s) {
 std::vector<BounceVariant> read_bounce_variants(Reader& ex, const std::string& v) {
   std::vector<BounceVariant> variants;
   std::size_t pos = 0;
-  try {
-    do {
-      const std::size_t comma = v.find(',', pos);
-      const BounceVariant b = parse_bounce_variant(v.substr(pos, comma - pos));
-      if (std::find(variants.begin(), variants.end(), b) != variants.end())
-        ex.bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(v) +
-                               " (a variant compared with itself decides nothing)");
-      variants.push_back(b);
-      pos = comma == std::string::npos ? comma : comma + 1;
-    } while (pos != std::string::npos);
-  } catch (const std::invalid_argument& err) {
-    ex.bad("variants", err.what());
-  }
+  do {
+    const std::size_t comma = v.find(',', pos);
+    BounceVariant b{};
+    try {
+      b = parse_bounce_variant(v.substr(pos, comma - pos));
+    } catch (const std::invalid_argument& err) {
+      ex.bad("variants", err.what());
+    }
+    if (std::find(variants.begin(), variants.end(), b) != variants.end())
+      ex.bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(v) +
+                             " (a variant compared with itself decides nothing)");
+    variants.push_back(b);
+    pos = comma == std::string::npos ? comma : comma + 1;
+  } while (pos != std::string::npos);
   return variants;
 }
 

@@ -346,31 +346,9 @@ void apply_backend_option(const Scene& scene, const OptionKind& k) {
                         "asperities are drawn from the exact law): add --mode explicit");
 }
 
-// --variant "paper,dynamic,...": each variant once (parse_bounce_variant names an unknown one).
-std::vector<BounceVariant> parse_variants(const std::string& variants) {
-  std::vector<BounceVariant> out;
-  std::size_t pos = 0;
-  do {
-    const std::size_t comma = variants.find(',', pos);
-    const BounceVariant v = parse_bounce_variant(variants.substr(pos, comma - pos));
-    if (std::find(out.begin(), out.end(), v) != out.end())
-      throw BadInput("--variant: '" + std::string(to_string(v)) + "' is given twice in '" + variants +
-                     "' (a variant compared with itself decides nothing)");
-    out.push_back(v);
-    pos = comma == std::string::npos ? comma : comma + 1;
-  } while (pos != std::string::npos);
-  return out;
-}
-
-// --variant, --sequences, and --speed as the bounce's first speed.
-void apply_bounce_options(Scene& scene, const RawOptions& r, const Given& given) {
-  if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
-    throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
-  if (!scene.bounce.enabled) return;
-  auto& e = scene.ensemble;
-  if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
-  if (given("--sequences")) scene.bounce.sequences = count_option(r, "--sequences");
-  if (given("--variant")) scene.bounce.variants = parse_variants(r["--variant"]);
+// --speed as the bounce's first speed.
+void apply_bounce_options(Scene& scene, const Given& given) {
+  if (given("--speed") && scene.bounce.enabled) scene.bounce.speed = scene.ensemble.impact.speed, scene.ensemble.impact.enabled = false;
 }
 
 // --tangential MODEL[:KEY=VALUE[,KEY=VALUE]]: the items of material.tangential, which its one reader
@@ -473,7 +451,8 @@ std::variant<std::int64_t, double, std::string> scene_value(const std::string& f
 // The options that are edits of one scene key (their rows' target), read with the scene.
 std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
   std::vector<SceneEdit> edits;
-  for (const char* flag : {"--asperities", "--drops", "--seed", "--backend", "--threads", "--statistics", "--bins-log2", "--alpha"})
+  for (const char* flag : {"--asperities", "--drops", "--seed", "--backend", "--threads", "--statistics", "--bins-log2", "--alpha",
+                           "--sequences", "--variant"})
     if (given(flag))
       edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag]),
                        std::string_view(flag) == "--asperities" ? "areal_density" : ""});
@@ -495,7 +474,7 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   apply_impact_options(scene, r, given, k);
   if (given("--backend")) apply_backend_option(scene, k);
   if (given("--kernel")) apply_kernel_option(scene, r, k);
-  apply_bounce_options(scene, r, given);
+  apply_bounce_options(scene, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
   apply_streaming_options(control, r, given, k);
   apply_run_options(scene, r, given);
