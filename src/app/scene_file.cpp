@@ -1010,7 +1010,11 @@ void apply_edits(toml::table& root, const std::vector<SceneEdit>& edits) {
       if (!t) throw SceneError(e.option + ": " + e.key + ": the scene's " + part + " is not a table", e.key);
     }
     std::visit([&](const auto& v) { t->insert_or_assign(std::string(key), v); }, e.value);
-    if (!e.replaces.empty()) t->erase(e.replaces);
+    for (const std::string& k : e.replaces) {
+      if (k.starts_with('[')) root.erase(k.substr(1, k.size() - 2));
+      for (auto it = t->begin(); k == "*" && it != t->end();) it = it->first == key ? std::next(it) : t->erase(it);
+      t->erase(k);
+    }
   }
 }
 
