@@ -51,8 +51,8 @@ TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
       {"--asperities 0", "got 0"},          {"--asperities -5", "-5"},          {"--asperities abc", "abc"},
       {"--asperities 1.5", "1.5"},        {"--asperities nan", "nan"},        {"--asperities inf", "inf"},
       {"--asperities 1e40", "1e+40"},      {"--asperities 5000000000", "5000000000"},
-      {"--radius 0", "'0'"},              {"--radius -1", "-1"},              {"--radius nan", "nan"},
-      {"--radius inf", "inf"},            {"--radius 3mm", "3mm"},            {"--radius ''", "''"},
+      {"--radius 0", "got 0"},              {"--radius -1", "-1"},              {"--radius nan", "nan"},
+      {"--radius inf", "inf"},            {"--radius 3mm", "3mm"},            {"--radius ''", "got \"\""},
       {"--asperity-radius 0", "got 0"},     {"--asperity-radius 0.003", "smaller"},
       {"--asperity-radius 1 --radius 0.5", "smaller"},                       {"--asperity-radius -1e-7", "got -1e-07"},
       {"--drops 0", "got 0"},           {"--drops 1", "must be >= 2"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
@@ -517,8 +517,8 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {L + " --omega-y 1", "--omega-y: a run with unequal asperity radii on a sphere"},
       {L + " --backend grid", "--backend: ensemble.backend: only mode = \"explicit\" queries a contact index"},
       {L + " --spheres 3", "--spheres: ensemble.spheres: only mode = \"explicit\""},
-      {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
-      {M + " --radius 1e-3", "--radius: a mesh body's size"},
+      {L + " --radius 1e-6", "must be smaller than body.radius = 1e-06"},  // the file's levels, checked again
+      {M + " --radius 1e-3", "--radius: body.radius: only for kind = \"sphere\""},
       {M + " --mode sampled", "--mode: ensemble.mode: a mesh body needs mode = \"explicit\""},
       {M + " --backend grid", "--backend: ensemble.backend: mesh bodies and unequal asperity radii"},
       // --tangential (issue 18): read by the one reader of material.tangential (issue 38), each key

@@ -200,19 +200,7 @@ OptionKind option_kind(const Scene& scene) {
   return k;
 }
 
-// --radius.
-void apply_body_options(Scene& scene, const RawOptions& r, const Given& given) {
-  auto& e = scene.ensemble;
-  if (given("--radius")) {
-    const double radius = parse_positive("--radius", r["--radius"]);
-    if (scene.mesh)
-      refuse("--radius", "a mesh body's size is its mesh file x body.scale (body.kind = \"mesh\"); --radius is the "
-                         "radius of a sphere body");
-    e.sphere.radius = radius;
-  }
-}
-
-// --drops, --mode, --spheres on the kinds of run they do not apply to (their values: the reader).
+// --drops, --mode, --spheres, --kernel on the kinds of run they do not apply to (their values: the reader).
 void refuse_design_options(const Given& given, const OptionKind& k) {
   if (given("--drops") && k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
   if (given("--mode") && k.bounce) refuse("--mode", "not used by " + k.text + ": every sequence bounces its own sphere");
@@ -353,7 +341,7 @@ std::variant<std::int64_t, double, std::string> scene_value(const std::string& f
 // the explicit design's spheres, backend and kernel (unless given too).
 std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
   std::vector<SceneEdit> edits;
-  for (const char* flag : {"--asperities", "--drops", "--mode", "--spheres", "--seed", "--backend", "--kernel", "--threads",
+  for (const char* flag : {"--radius", "--asperities", "--drops", "--mode", "--spheres", "--seed", "--backend", "--kernel", "--threads",
                            "--statistics", "--bins-log2", "--alpha", "--sequences", "--variant"}) {
     if (!given(flag)) continue;
     const std::string_view f(flag);
@@ -382,7 +370,6 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   Scene scene = !given("--scene") && !given("--resume") ? preset(r["--preset"], edits) : load ? load(path, edits)
                                                                                         : load_scene(path, edits);
   if (given("--resume")) scene.out = r["--resume"], control.resume = true;
-  apply_body_options(scene, r, given);
   const OptionKind k = option_kind(scene);
   refuse_design_options(given, k);
   apply_impact_options(scene, r, given, k);
