@@ -58,7 +58,7 @@ Scene load_scene(const std::filesystem::path& file);
 struct SceneEdit {
   std::string key;     ///< dotted: "ensemble.drops"
   std::string option;  ///< "--drops"
-  std::variant<std::int64_t, double, std::string> value;
+  std::variant<std::int64_t, double, std::string, bool> value;
   /// What this key replaces (removed): keys of the same table ("areal_density"), "*" for every
   /// other key of that table, "[screening]" for a table of the scene.
   std::vector<std::string> replaces;

@@ -18,7 +18,6 @@
 
 #include "asperity/app/option_table.hpp"
 #include "asperity/app/plan.hpp"
-#include "asperity/app/plot.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/config.hpp"
@@ -299,20 +298,11 @@ void check_resume_option(const RawOptions& r, const Given& given) {
   if (r["--resume"].empty()) throw BadInput("--resume: '' is not a directory name");
 }
 
-// --threads, --alpha, --no-plots, --out; and the scene's name says when options changed the physics.
+// --alpha on bounce runs, --out; and the scene's name says when options changed the physics.
 void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
   if (given("--alpha") && scene.bounce.enabled)
     throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
                    "decide nothing (exit status 0)");
-  if (r.no_plots) scene.plots = false;
-  if (given("--plot-format")) {
-    try {
-      parse_plot_formats(r["--plot-format"]);
-    } catch (const std::invalid_argument& ex) {
-      throw BadInput(std::string("--plot-format: ") + ex.what());
-    }
-    scene.plot_format = r["--plot-format"];
-  }
   if (given("--out")) {
     if (r["--out"].empty()) throw BadInput("--out: '' is not a directory name");
     scene.out = r["--out"];
@@ -327,7 +317,7 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
 // an integer (a seed above 2^63 - 1 as its digits, as scene files write it), another number as a
 // float, any other text as a string.
 // A float goes through parse_real: a value beyond a double's normal range is named as written.
-std::variant<std::int64_t, double, std::string> scene_value(const std::string& flag, const std::string& text) {
+decltype(SceneEdit::value) scene_value(const std::string& flag, const std::string& text) {
   if (!decimal_syntax(text)) return text;
   const long double v = std::strtold(text.c_str(), nullptr);
   if (v == std::floor(v) && text[0] == '+') return text;  // whole numbers are written without a sign
@@ -342,7 +332,7 @@ std::variant<std::int64_t, double, std::string> scene_value(const std::string& f
 std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
   std::vector<SceneEdit> edits;
   for (const char* flag : {"--radius", "--asperities", "--drops", "--mode", "--spheres", "--seed", "--backend", "--kernel", "--threads",
-                           "--statistics", "--bins-log2", "--alpha", "--sequences", "--variant"}) {
+                           "--statistics", "--bins-log2", "--alpha", "--sequences", "--variant", "--plot-format"}) {
     if (!given(flag)) continue;
     const std::string_view f(flag);
     std::vector<std::string> replaces;
@@ -352,10 +342,11 @@ std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
         if (!given(("--" + std::string(key)).c_str())) replaces.emplace_back(key);
     edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag]), replaces});
   }
+  if (r.no_plots) edits.push_back({"outputs.plots", "--no-plots", false, {}});
   // Every asperity gets this radius: "fixed" replaces a "levels"/"lognormal" distribution and its
   // [screening] (on a sphere the run becomes the paper's; a mesh stays a mesh run).
   if (given("--asperity-radius")) {
-    edits.push_back({"asperities.radius.distribution", "--asperity-radius", "fixed", {"*", "[screening]"}});
+    edits.push_back({"asperities.radius.distribution", "--asperity-radius", std::string("fixed"), {"*", "[screening]"}});
     edits.push_back({"asperities.radius.value", "--asperity-radius", scene_value("--asperity-radius", r["--asperity-radius"]), {}});
   }
   return edits;
