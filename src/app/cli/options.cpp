@@ -298,15 +298,11 @@ void check_resume_option(const RawOptions& r, const Given& given) {
   if (r["--resume"].empty()) throw BadInput("--resume: '' is not a directory name");
 }
 
-// --alpha on bounce runs, --out; and the scene's name says when options changed the physics.
+// --alpha on bounce runs; and the scene's name says when options changed the physics.
 void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
   if (given("--alpha") && scene.bounce.enabled)
     throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
                    "decide nothing (exit status 0)");
-  if (given("--out")) {
-    if (r["--out"].empty()) throw BadInput("--out: '' is not a directory name");
-    scene.out = r["--out"];
-  }
   if (!given("--scene") && !given("--resume") && r["--preset"] != scene.name) scene.name = r["--preset"];
   if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
       given("--speed") || given("--omega-x") || given("--omega-y") || given("--tangential"))
@@ -342,6 +338,7 @@ std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
         if (!given(("--" + std::string(key)).c_str())) replaces.emplace_back(key);
     edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag]), replaces});
   }
+  if (given("--out")) edits.push_back({"outputs.dir", "--out", r["--out"], {}});  // a name, even "2024"
   if (r.no_plots) edits.push_back({"outputs.plots", "--no-plots", false, {}});
   // Every asperity gets this radius: "fixed" replaces a "levels"/"lognormal" distribution and its
   // [screening] (on a sphere the run becomes the paper's; a mesh stays a mesh run).
