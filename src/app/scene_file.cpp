@@ -655,19 +655,20 @@ void read_screening(Reader& top, Scene& s) {
 std::vector<BounceVariant> read_bounce_variants(Reader& ex, const std::string& v) {
   std::vector<BounceVariant> variants;
   std::size_t pos = 0;
-  try {
-    do {
-      const std::size_t comma = v.find(',', pos);
-      const BounceVariant b = parse_bounce_variant(v.substr(pos, comma - pos));
-      if (std::find(variants.begin(), variants.end(), b) != variants.end())
-        ex.bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(v) +
-                               " (a variant compared with itself decides nothing)");
-      variants.push_back(b);
-      pos = comma == std::string::npos ? comma : comma + 1;
-    } while (pos != std::string::npos);
-  } catch (const std::invalid_argument& err) {
-    ex.bad("variants", err.what());
-  }
+  do {
+    const std::size_t comma = v.find(',', pos);
+    BounceVariant b{};
+    try {
+      b = parse_bounce_variant(v.substr(pos, comma - pos));
+    } catch (const std::invalid_argument& err) {
+      ex.bad("variants", err.what());
+    }
+    if (std::find(variants.begin(), variants.end(), b) != variants.end())
+      ex.bad("variants", "\"" + std::string(to_string(b)) + "\" is given twice in " + quote(v) +
+                             " (a variant compared with itself decides nothing)");
+    variants.push_back(b);
+    pos = comma == std::string::npos ? comma : comma + 1;
+  } while (pos != std::string::npos);
   return variants;
 }
 
@@ -1009,7 +1010,11 @@ void apply_edits(toml::table& root, const std::vector<SceneEdit>& edits) {
       if (!t) throw SceneError(e.option + ": " + e.key + ": the scene's " + part + " is not a table", e.key);
     }
     std::visit([&](const auto& v) { t->insert_or_assign(std::string(key), v); }, e.value);
-    if (!e.replaces.empty()) t->erase(e.replaces);
+    for (const std::string& k : e.replaces) {
+      if (k.starts_with('[')) root.erase(k.substr(1, k.size() - 2));
+      for (auto it = t->begin(); k == "*" && it != t->end();) it = it->first == key ? std::next(it) : t->erase(it);
+      t->erase(k);
+    }
   }
 }
 

@@ -51,16 +51,16 @@ TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
       {"--asperities 0", "got 0"},          {"--asperities -5", "-5"},          {"--asperities abc", "abc"},
       {"--asperities 1.5", "1.5"},        {"--asperities nan", "nan"},        {"--asperities inf", "inf"},
       {"--asperities 1e40", "1e+40"},      {"--asperities 5000000000", "5000000000"},
-      {"--radius 0", "'0'"},              {"--radius -1", "-1"},              {"--radius nan", "nan"},
-      {"--radius inf", "inf"},            {"--radius 3mm", "3mm"},            {"--radius ''", "''"},
-      {"--asperity-radius 0", "'0'"},     {"--asperity-radius 0.003", "smaller"},
-      {"--asperity-radius 1 --radius 0.5", "smaller"},                       {"--asperity-radius -1e-7", "-1e-7"},
+      {"--radius 0", "got 0"},              {"--radius -1", "-1"},              {"--radius nan", "nan"},
+      {"--radius inf", "inf"},            {"--radius 3mm", "3mm"},            {"--radius ''", "got \"\""},
+      {"--asperity-radius 0", "got 0"},     {"--asperity-radius 0.003", "smaller"},
+      {"--asperity-radius 1 --radius 0.5", "smaller"},                       {"--asperity-radius -1e-7", "got -1e-07"},
       {"--drops 0", "got 0"},           {"--drops 1", "must be >= 2"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
       {"--preset fig99", "fig99"},        {"--backend octree --mode fixed", "octree"},
       {"--mode frozen", "frozen"},        {"--alpha 0", "alpha"},             {"--alpha 1.5", "alpha"},
       {"--alpha nan", "alpha"},           {"--threads -1", "-1"},             {"--seed -3", "-3"},
       {"--seed x1", "x1"},                {"--mode fixed --spheres 3 --drops 1000", "multiple"},
-      {"--spheres 0 --mode fixed", "'0'"}, {"--frobnicate 3", "frobnicate"},
+      {"--spheres 0 --mode fixed", "got 0"}, {"--frobnicate 3", "frobnicate"},
       {"--kernel avx", "avx"},            {"--kernel gpu", "CUDA"},
       {"--kernel scalar --mode sampled", "--kernel"},
   };
@@ -504,22 +504,22 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
   const fs::path lv = levels_scene(out), mesh = mesh_scene(out);
   const std::string L = "--scene " + lv.string(), M = "--scene " + mesh.string();
   const std::vector<Bad> cases = {
-      {"--mode sampled --backend grid", "--backend: only for the explicit design"},
-      {"--mode sampled --spheres 4", "--spheres: only for the explicit design"},
+      {"--mode sampled --backend grid", "--backend: ensemble.backend: only mode = \"explicit\" queries a contact index"},
+      {"--mode sampled --spheres 4", "--spheres: ensemble.spheres: only mode = \"explicit\" uses explicit spheres"},
       {"--preset fig6 --drops 100", "--drops: not used by a bounce run"},
       {"--preset fig6 --mode fixed", "--mode: not used by a bounce run"},
       {"--preset fig6 --alpha 0.05", "--alpha: not used by a bounce run"},
       {"--preset fig6 --omega-x 1", "--omega-x: not used by a bounce run"},
       {"--preset fig6 --spheres 2", "--spheres: not used by a bounce run"},
       {"--preset fig6 --backend grid", "--backend: not used by a bounce run"},
-      {L + " --mode fixed", "--mode: 'fixed'"},
+      {L + " --mode fixed", "--mode: ensemble.mode: unequal asperity radii on a sphere draw from their exact sampler"},
       {L + " --speed 1", "--speed: a run with unequal asperity radii on a sphere"},
       {L + " --omega-y 1", "--omega-y: a run with unequal asperity radii on a sphere"},
       {L + " --backend grid", "--backend: ensemble.backend: only mode = \"explicit\" queries a contact index"},
-      {L + " --spheres 3", "--spheres: not used by a run with unequal asperity radii"},
-      {L + " --radius 1e-6", "must be smaller than radius = 1e-06"},  // the file's levels, checked again
-      {M + " --radius 1e-3", "--radius: a mesh body's size"},
-      {M + " --mode sampled", "--mode: 'sampled'"},
+      {L + " --spheres 3", "--spheres: ensemble.spheres: only mode = \"explicit\""},
+      {L + " --radius 1e-6", "must be smaller than body.radius = 1e-06"},  // the file's levels, checked again
+      {M + " --radius 1e-3", "--radius: body.radius: only for kind = \"sphere\""},
+      {M + " --mode sampled", "--mode: ensemble.mode: a mesh body needs mode = \"explicit\""},
       {M + " --backend grid", "--backend: ensemble.backend: mesh bodies and unequal asperity radii"},
       // --tangential (issue 18): read by the one reader of material.tangential (issue 38), each key
       // named as in a scene file.

@@ -227,7 +227,7 @@ TEST(CliRefusals, CrashesAndSilentNonsenseAreRefusedUpFrontNamingTheKey) {
       {"", "format = 1\n[outputs]\nreport = \"a\\u0000b.json\"\n", "control character"},
       {"", "format = 1\n[outputs]\nreport = \"sub/r.json\"\n", "outputs.report"},
       // 9: duplicate variants
-      {"--preset fig6 --variant paper,paper", "", "--variant: 'paper' is given twice"},
+      {"--preset fig6 --variant paper,paper", "", "--variant: experiment.variants: \"paper\" is given twice"},
       // issue 33 item 6: NaN reported with exit 0 (1e155, gravity 1e19, 5e-324) or an internal
       // message (1e7): a bounce's stated ranges, key and value named
       {"--preset fig6 --asperities 1000 --sequences 20 --speed 1e155", "", "experiment.speed (--speed): 1e+155 m/s is outside the supported range (0, 1000]"},

@@ -58,8 +58,10 @@ Scene load_scene(const std::filesystem::path& file);
 struct SceneEdit {
   std::string key;     ///< dotted: "ensemble.drops"
   std::string option;  ///< "--drops"
-  std::variant<std::int64_t, double, std::string> value;
-  std::string replaces;  ///< a key of the same table that this one replaces (removed): "areal_density"
+  std::variant<std::int64_t, double, std::string, bool> value;
+  /// What this key replaces (removed): keys of the same table ("areal_density"), "*" for every
+  /// other key of that table, "[screening]" for a table of the scene.
+  std::vector<std::string> replaces;
 };
 
 /// parse_scene, load_scene and preset with `edits` applied to the table before it is read.

@@ -18,7 +18,6 @@
 
 #include "asperity/app/option_table.hpp"
 #include "asperity/app/plan.hpp"
-#include "asperity/app/plot.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/config.hpp"
@@ -79,61 +78,6 @@ double parse_positive(const std::string& option, const std::string& text, const 
   return v;
 }
 
-std::string bound_text(std::uint64_t v) {
-  std::string s = std::to_string(v);
-  for (int k = 16; k < 64; ++k) {
-    const std::uint64_t p = std::uint64_t{1} << k;
-    if (v == p) return s + " (2^" + std::to_string(k) + ")";
-    if (v == p - 1) return s + " (2^" + std::to_string(k) + " - 1)";
-  }
-  if (v == ~std::uint64_t{0}) return s + " (2^64 - 1)";
-  return s;
-}
-
-// Counts are integers: digits, or exact scientific notation ("1e5", "2.5e3"); no sign, spaces,
-// hexadecimal or rounding. The value must lie in [lo, hi], named in the message.
-std::uint64_t parse_count(const std::string& option, const std::string& text, std::uint64_t lo, std::uint64_t hi) {
-  const std::string got = option + ": '" + text + "' ";
-  const bool negative = !text.empty() && text[0] == '-';
-  if (names_infinity_or_nan(text)) throw BadInput(got + "must be a finite whole number");
-  if (!decimal_syntax(text) || text[0] == '+')
-    throw BadInput(got + "is not a whole number (write digits, e.g. 1000 or 1e3)");
-  if (negative) throw BadInput(got + "must be >= " + std::to_string(lo));
-  // Exact: mantissa digits x 10^exponent.
-  std::string mant;
-  long long exp10 = 0;
-  std::size_t i = 0;
-  for (; i < text.size() && text[i] != 'e' && text[i] != 'E'; ++i) {
-    if (text[i] == '.') continue;
-    mant += text[i];
-  }
-  const std::size_t dot = text.find('.');
-  const std::size_t epos = text.find_first_of("eE");
-  if (dot != std::string::npos) exp10 -= static_cast<long long>((epos == std::string::npos ? text.size() : epos) - dot - 1);
-  if (epos != std::string::npos) {
-    const std::string e = text.substr(epos + 1);
-    if (e.size() > 6) throw BadInput(got + (e[0] == '-' ? "must be a whole number >= " + std::to_string(lo) : "is too large: must be <= " + bound_text(hi)));
-    exp10 += std::stoll(e);
-  }
-  mant.erase(0, std::min(mant.find_first_not_of('0'), mant.size()));
-  if (mant.empty()) mant = "0";
-  while (exp10 < 0 && mant.size() > 1 && mant.back() == '0') mant.pop_back(), ++exp10;
-  if (mant == "0") exp10 = 0;
-  if (exp10 < 0) throw BadInput(got + "must be a whole number");
-  if (static_cast<long long>(mant.size()) + exp10 > 20) throw BadInput(got + "is too large: must be <= " + bound_text(hi));
-  constexpr std::uint64_t kMax = ~std::uint64_t{0};
-  std::uint64_t v = 0;
-  auto push = [&](unsigned d) {
-    if (v > (kMax - d) / 10) throw BadInput(got + "is too large: must be <= " + bound_text(hi));
-    v = v * 10 + d;
-  };
-  for (char c : mant) push(static_cast<unsigned>(c - '0'));
-  for (long long k = 0; k < exp10; ++k) push(0);
-  if (v > hi) throw BadInput(got + "must be <= " + bound_text(hi));
-  if (v < lo) throw BadInput(got + "must be >= " + std::to_string(lo));
-  return v;
-}
-
 // The options as the user wrote them, by long flag: every value is text until its own parser
 // reads it, so that a bad value is named as written.
 struct RawOptions {
@@ -152,12 +96,6 @@ std::string result_free_options() {
   for (const OptionRow& row : option_rows())
     if (!row.changes_result && long_flag(row) != "--resume") list += (list.empty() ? "" : ", ") + std::string(long_flag(row));
   return list;
-}
-
-// A COUNT option in its row's range.
-std::uint64_t count_option(const RawOptions& r, std::string_view flag) {
-  const OptionRow& row = option_row(flag);
-  return parse_count(std::string(flag), r[flag], row.lo, row.hi);
 }
 
 // The options from their rows (option_table.hpp): type, range and help in --help.
@@ -261,55 +199,13 @@ OptionKind option_kind(const Scene& scene) {
   return k;
 }
 
-// --asperities, --radius, --asperity-radius.
-void apply_body_options(Scene& scene, const RawOptions& r, const Given& given) {
-  auto& e = scene.ensemble;
-  if (given("--radius")) {
-    const double radius = parse_positive("--radius", r["--radius"]);
-    if (scene.mesh)
-      refuse("--radius", "a mesh body's size is its mesh file x body.scale (body.kind = \"mesh\"); --radius is the "
-                         "radius of a sphere body");
-    e.sphere.radius = radius;
-  }
-  if (given("--asperity-radius")) {
-    // Every asperity gets this radius: the option replaces a "levels"/"lognormal" distribution of
-    // the file by "fixed" (on a sphere the run becomes the paper's; a mesh stays a mesh run).
-    e.sphere.asperity_radius = parse_positive("--asperity-radius", r["--asperity-radius"]);
-    scene.radii.reset();
-  }
-}
-
-void apply_mode_option(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
-  auto& e = scene.ensemble;
-  const std::string& mode = r["--mode"];
-  e.mode = parse_mode(mode);
-  // Earlier names: "fixed" = explicit; "fresh" = explicit (with a note), for unequal radii their sampler.
-  scene.legacy_mode = is_legacy_mode(mode) && !k.radii && !k.mesh && !k.bounce ? mode : std::string();
-  if (k.radii && mode == "fresh") e.mode = Mode::sampled;
-  // A backend the file chose for its explicit spheres does not apply to sampled drops.
-  if (e.mode == Mode::sampled && !given("--backend")) scene.backend_auto = true;
-  if (k.bounce) refuse("--mode", "not used by " + k.text + ": every sequence bounces its own sphere");
-  if (k.mesh && e.mode != Mode::explicit_spheres)
-    refuse("--mode", "'" + mode + "': " + k.text + " runs explicit bodies x rotations: only \"explicit\"");
-  if (k.radii && e.mode != Mode::sampled)
-    refuse("--mode", "'" + mode + "': " + k.text + " draws from its exact sampler and screens [screening] bodies: only "
-                     "\"sampled\" (or give --asperity-radius for the paper's equal radii)");
-}
-
-// --drops, --mode, --spheres, --seed: the design of the ensemble.
-void apply_design_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
-  auto& e = scene.ensemble;
+// --drops, --mode, --spheres, --kernel on the kinds of run they do not apply to (their values: the reader).
+void refuse_design_options(const Given& given, const OptionKind& k) {
   if (given("--drops") && k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
-  if (given("--mode")) apply_mode_option(scene, r, given, k);
-  if (given("--spheres")) {
-    e.spheres = count_option(r, "--spheres");
-    scene.spheres_auto = false;
-    if ((k.bounce && !k.mesh) || k.radii)
-      refuse("--spheres", "not used by " + k.text + (k.radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
-    if (!k.mesh && e.mode != Mode::explicit_spheres)
-      refuse("--spheres", "only for the explicit design (explicit spheres x rotations); sampled drops build no sphere: "
-                          "add --mode explicit");
-  }
+  if (given("--mode") && k.bounce) refuse("--mode", "not used by " + k.text + ": every sequence bounces its own sphere");
+  if (given("--spheres") && ((k.bounce && !k.mesh) || k.radii))
+    refuse("--spheres", "not used by " + k.text + (k.radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
+  if (given("--kernel") && (k.bounce || k.mesh || k.radii)) refuse("--kernel", "not used by " + k.text + " (explicit sphere drops only)");
 }
 
 // --speed, --omega-x, --omega-y: the impact (a mesh body's bounce takes the spin as its start).
@@ -346,31 +242,9 @@ void apply_backend_option(const Scene& scene, const OptionKind& k) {
                         "asperities are drawn from the exact law): add --mode explicit");
 }
 
-// --variant "paper,dynamic,...": each variant once (parse_bounce_variant names an unknown one).
-std::vector<BounceVariant> parse_variants(const std::string& variants) {
-  std::vector<BounceVariant> out;
-  std::size_t pos = 0;
-  do {
-    const std::size_t comma = variants.find(',', pos);
-    const BounceVariant v = parse_bounce_variant(variants.substr(pos, comma - pos));
-    if (std::find(out.begin(), out.end(), v) != out.end())
-      throw BadInput("--variant: '" + std::string(to_string(v)) + "' is given twice in '" + variants +
-                     "' (a variant compared with itself decides nothing)");
-    out.push_back(v);
-    pos = comma == std::string::npos ? comma : comma + 1;
-  } while (pos != std::string::npos);
-  return out;
-}
-
-// --variant, --sequences, and --speed as the bounce's first speed.
-void apply_bounce_options(Scene& scene, const RawOptions& r, const Given& given) {
-  if ((given("--variant") || given("--sequences")) && !scene.bounce.enabled)
-    throw BadInput("--variant/--sequences need a bounce run: --preset fig6");
-  if (!scene.bounce.enabled) return;
-  auto& e = scene.ensemble;
-  if (given("--speed")) scene.bounce.speed = e.impact.speed, e.impact.enabled = false;
-  if (given("--sequences")) scene.bounce.sequences = count_option(r, "--sequences");
-  if (given("--variant")) scene.bounce.variants = parse_variants(r["--variant"]);
+// --speed as the bounce's first speed.
+void apply_bounce_options(Scene& scene, const Given& given) {
+  if (given("--speed") && scene.bounce.enabled) scene.bounce.speed = scene.ensemble.impact.speed, scene.ensemble.impact.enabled = false;
 }
 
 // --tangential MODEL[:KEY=VALUE[,KEY=VALUE]]: the items of material.tangential, which its one reader
@@ -414,15 +288,6 @@ void apply_streaming_options(RunControl& control, const RawOptions& r, const Giv
     refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
 }
 
-// --kernel: the drop kernel of explicit sphere drops. It changes no bit, so it may come with
-// --resume; validate() refuses one this build lacks.
-void apply_kernel_option(Scene& scene, const RawOptions& r, const OptionKind& k) {
-  scene.ensemble.kernel = parse_kernel(r["--kernel"]);
-  if (k.bounce || k.mesh || k.radii) refuse("--kernel", "not used by " + k.text + " (explicit sphere drops only)");
-  if (scene.ensemble.mode != Mode::explicit_spheres)
-    refuse("--kernel", "only for the explicit design (explicit spheres); sampled drops run no drop kernel: add --mode explicit");
-}
-
 // --resume DIR: the checkpoint's own scene; only options that change no result (their rows) may
 // come with it.
 void check_resume_option(const RawOptions& r, const Given& given) {
@@ -433,24 +298,11 @@ void check_resume_option(const RawOptions& r, const Given& given) {
   if (r["--resume"].empty()) throw BadInput("--resume: '' is not a directory name");
 }
 
-// --threads, --alpha, --no-plots, --out; and the scene's name says when options changed the physics.
+// --alpha on bounce runs; and the scene's name says when options changed the physics.
 void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
   if (given("--alpha") && scene.bounce.enabled)
     throw BadInput("--alpha: not used by a bounce run (experiment.kind = \"bounce\"): its fits describe, they "
                    "decide nothing (exit status 0)");
-  if (r.no_plots) scene.plots = false;
-  if (given("--plot-format")) {
-    try {
-      parse_plot_formats(r["--plot-format"]);
-    } catch (const std::invalid_argument& ex) {
-      throw BadInput(std::string("--plot-format: ") + ex.what());
-    }
-    scene.plot_format = r["--plot-format"];
-  }
-  if (given("--out")) {
-    if (r["--out"].empty()) throw BadInput("--out: '' is not a directory name");
-    scene.out = r["--out"];
-  }
   if (!given("--scene") && !given("--resume") && r["--preset"] != scene.name) scene.name = r["--preset"];
   if (given("--asperities") || given("--radius") || given("--asperity-radius") || given("--mode") ||
       given("--speed") || given("--omega-x") || given("--omega-y") || given("--tangential"))
@@ -461,7 +313,7 @@ void apply_run_options(Scene& scene, const RawOptions& r, const Given& given) {
 // an integer (a seed above 2^63 - 1 as its digits, as scene files write it), another number as a
 // float, any other text as a string.
 // A float goes through parse_real: a value beyond a double's normal range is named as written.
-std::variant<std::int64_t, double, std::string> scene_value(const std::string& flag, const std::string& text) {
+decltype(SceneEdit::value) scene_value(const std::string& flag, const std::string& text) {
   if (!decimal_syntax(text)) return text;
   const long double v = std::strtold(text.c_str(), nullptr);
   if (v == std::floor(v) && text[0] == '+') return text;  // whole numbers are written without a sign
@@ -470,13 +322,30 @@ std::variant<std::int64_t, double, std::string> scene_value(const std::string& f
   return parse_real(flag, text);
 }
 
-// The options that are edits of one scene key (their rows' target), read with the scene.
+// The options that are edits of one scene key (their rows' target), read with the scene. An edit
+// removes the file's keys that it makes inapplicable: --asperities an areal_density; --mode sampled
+// the explicit design's spheres, backend and kernel (unless given too).
 std::vector<SceneEdit> scene_edits(const RawOptions& r, const Given& given) {
   std::vector<SceneEdit> edits;
-  for (const char* flag : {"--asperities", "--drops", "--seed", "--backend", "--threads", "--statistics", "--bins-log2", "--alpha"})
-    if (given(flag))
-      edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag]),
-                       std::string_view(flag) == "--asperities" ? "areal_density" : ""});
+  for (const char* flag : {"--radius", "--asperities", "--drops", "--mode", "--spheres", "--seed", "--backend", "--kernel", "--threads",
+                           "--statistics", "--bins-log2", "--alpha", "--sequences", "--variant", "--plot-format"}) {
+    if (!given(flag)) continue;
+    const std::string_view f(flag);
+    std::vector<std::string> replaces;
+    if (f == "--asperities") replaces = {"areal_density"};
+    if (f == "--mode" && r[f] == "sampled")
+      for (const char* key : {"spheres", "backend", "kernel"})
+        if (!given(("--" + std::string(key)).c_str())) replaces.emplace_back(key);
+    edits.push_back({std::string(option_row(flag).target), flag, scene_value(flag, r[flag]), replaces});
+  }
+  if (given("--out")) edits.push_back({"outputs.dir", "--out", r["--out"], {}});  // a name, even "2024"
+  if (r.no_plots) edits.push_back({"outputs.plots", "--no-plots", false, {}});
+  // Every asperity gets this radius: "fixed" replaces a "levels"/"lognormal" distribution and its
+  // [screening] (on a sphere the run becomes the paper's; a mesh stays a mesh run).
+  if (given("--asperity-radius")) {
+    edits.push_back({"asperities.radius.distribution", "--asperity-radius", std::string("fixed"), {"*", "[screening]"}});
+    edits.push_back({"asperities.radius.value", "--asperity-radius", scene_value("--asperity-radius", r["--asperity-radius"]), {}});
+  }
   return edits;
 }
 
@@ -489,13 +358,11 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
   Scene scene = !given("--scene") && !given("--resume") ? preset(r["--preset"], edits) : load ? load(path, edits)
                                                                                         : load_scene(path, edits);
   if (given("--resume")) scene.out = r["--resume"], control.resume = true;
-  apply_body_options(scene, r, given);
   const OptionKind k = option_kind(scene);
-  apply_design_options(scene, r, given, k);
+  refuse_design_options(given, k);
   apply_impact_options(scene, r, given, k);
   if (given("--backend")) apply_backend_option(scene, k);
-  if (given("--kernel")) apply_kernel_option(scene, r, k);
-  apply_bounce_options(scene, r, given);
+  apply_bounce_options(scene, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
   apply_streaming_options(control, r, given, k);
   apply_run_options(scene, r, given);
