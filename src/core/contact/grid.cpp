@@ -174,18 +174,18 @@ inline V loadu(const T* p) noexcept {
   return v;
 }
 
-/// The two smallest keys over the three runs and their indices, when the keys differ.
-/// Key arithmetic: ((x-dx)^2 + (y-dy)^2) + (z-dz)^2, lane by lane, exactly contact_key's.
-/// Reads blocks of four records (transposed to x, y, z, id lanes) only while the run has points
-/// in them, so no cache line beyond the run's last block is touched.
-ASPERITY_GRID_CLONES
-TopPair top_pair(const Pt* pts, const Runs& runs, double dx, double dy, double dz) noexcept {
+/// The keys and ids of the 3 x kRowSlots slots of a window's three runs, INF / kNone past each
+/// run's end. Key arithmetic: ((x-dx)^2 + (y-dy)^2) + (z-dz)^2, lane by lane, exactly
+/// contact_key's. Reads blocks of four records (transposed to x, y, z, id lanes) only while the
+/// run has points in them, so no cache line beyond the run's last block is touched. Inlined into
+/// each ISA clone of its callers (top_pair, window_min64).
+constexpr int kWindowBlocks = 3 * (kRowSlots / 4);
+[[gnu::always_inline]] inline void window_keys(const Pt* pts, const Runs& runs, double dx, double dy, double dz,
+                                               v4d (&key)[kWindowBlocks], v4l (&ids)[kWindowBlocks]) noexcept {
   constexpr int kB = kRowSlots / 4;  // blocks of four slots per run
   const v4d DX = {dx, dx, dx, dx}, DY = {dy, dy, dy, dy}, DZ = {dz, dz, dz, dz};
   const v4d INF = {kInf, kInf, kInf, kInf};
   const long long none = kNone;
-  v4d key[3 * kB];
-  v4l ids[3 * kB];
   for (int r = 0; r < 3; ++r) {
     const long long n = runs.size[r];
     const v4l size = {n, n, n, n};
@@ -209,6 +209,17 @@ TopPair top_pair(const Pt* pts, const Runs& runs, double dx, double dy, double d
       ids[r * kB + q] = slot < size ? id : v4l{none, none, none, none};
     }
   }
+}
+
+/// The two smallest keys over the three runs and their indices, when the keys differ.
+ASPERITY_GRID_CLONES
+TopPair top_pair(const Pt* pts, const Runs& runs, double dx, double dy, double dz) noexcept {
+  constexpr int kB = kRowSlots / 4;
+  const v4d INF = {kInf, kInf, kInf, kInf};
+  const long long none = kNone;
+  v4d key[kWindowBlocks];
+  v4l ids[kWindowBlocks];
+  window_keys(pts, runs, dx, dy, dz, key, ids);
   // The two smallest values with multiplicity, per lane (a1 <= a2), then across lanes.
   v4d a1 = INF, a2 = INF;
   for (int q = 0; q < 3 * kB; ++q) {
@@ -327,35 +338,13 @@ Win window_winner(const float* fx, const float* fy, const float* fz, const Pt* p
 ASPERITY_GRID_CLONES
 Win window_min64(const Pt* pts, const Runs& runs, double dx, double dy, double dz) noexcept {
   constexpr int kB = kRowSlots / 4;
-  const v4d DX = {dx, dx, dx, dx}, DY = {dy, dy, dy, dy}, DZ = {dz, dz, dz, dz};
   const v4d INF = {kInf, kInf, kInf, kInf};
   const long long none = kNone;
-  v4d key[3 * kB];
-  v4l ids[3 * kB];
+  v4d key[kWindowBlocks];
+  v4l ids[kWindowBlocks];
+  window_keys(pts, runs, dx, dy, dz, key, ids);
   v4d a1 = INF;
-  for (int r = 0; r < 3; ++r) {
-    const long long n = runs.size[r];
-    const v4l size = {n, n, n, n};
-    for (int q = 0; q < kB; ++q) {
-      if (4 * q >= n) {
-        key[r * kB + q] = INF;
-        ids[r * kB + q] = v4l{none, none, none, none};
-        continue;
-      }
-      const Pt* p = pts + runs.begin[r] + 4u * static_cast<unsigned>(q);
-      const v4d p0 = loadu<v4d>(p), p1 = loadu<v4d>(p + 1), p2 = loadu<v4d>(p + 2), p3 = loadu<v4d>(p + 3);
-      const v4d t0 = __builtin_shuffle(p0, p1, v4l{0, 4, 2, 6}), t1 = __builtin_shuffle(p0, p1, v4l{1, 5, 3, 7});
-      const v4d t2 = __builtin_shuffle(p2, p3, v4l{0, 4, 2, 6}), t3 = __builtin_shuffle(p2, p3, v4l{1, 5, 3, 7});
-      const v4d x = __builtin_shuffle(t0, t2, v4l{0, 1, 4, 5}) - DX, y = __builtin_shuffle(t1, t3, v4l{0, 1, 4, 5}) - DY;
-      const v4d z = __builtin_shuffle(t0, t2, v4l{2, 3, 6, 7}) - DZ;
-      const v4l id = reinterpret_cast<v4l>(__builtin_shuffle(t1, t3, v4l{2, 3, 6, 7}));
-      const v4d k = (x * x + y * y) + z * z;
-      const v4l slot = v4l{0, 1, 2, 3} + 4 * q;
-      key[r * kB + q] = slot < size ? k : INF;
-      ids[r * kB + q] = slot < size ? id : v4l{none, none, none, none};
-      a1 = key[r * kB + q] < a1 ? key[r * kB + q] : a1;
-    }
-  }
+  for (int q = 0; q < 3 * kB; ++q) a1 = key[q] < a1 ? key[q] : a1;
   for (const v4l swap : {v4l{2, 3, 0, 1}, v4l{1, 0, 3, 2}}) {
     const v4d b1 = __builtin_shuffle(a1, swap);
     a1 = b1 < a1 ? b1 : a1;
