@@ -471,8 +471,9 @@ void test_explicit(GeometryReport& r, const TestContext& c, const LawSet& set, s
       any_atom(set) ? std::vector<double>{std::nextafter(set.atom, -kInf), set.atom} : std::vector<double>{};
   const BlockBins bins = bin_by_block(x, x.size() == c.v.n ? c.v.K : 1, kKsGrid, kMaxBlocks, extra);
   // Each law on every grid edge first, alone: a law that cannot be evaluated there is skipped by
-  // itself. Tested together, one law's NaN (Eq. 28 as printed at |Omega| ~ 1e-5 rad/s, an info
-  // law) skipped the whole set, the decisive eq28-corrected with it (issue 33 item 6).
+  // itself. Tested together, one law's NaN (Eq. 28 as printed where its raw integral crosses zero,
+  // e.g. Omega_x = 1 rad/s on fig4's sphere; an info law) would skip the whole set, the decisive
+  // eq28-corrected with it (issue 33 item 6).
   std::vector<std::pair<std::size_t, Cdf>> laws;
   for (auto& [li, cdf] : evaluable_laws(r, c, set, x)) {
     try {
