@@ -36,6 +36,10 @@ struct MemoryRefused : std::invalid_argument {
 /// memory_limit_bytes(): the run is refused before it starts (plan() calls it).
 void check_memory(const Plan& p);
 
+/// Measured bytes per asperity of an explicit sphere with a contact index of backend `b` (brute:
+/// the centres alone).
+double bytes_per_asperity(Backend b);
+
 /// Bytes of an explicit sphere of `asperities` centres with a contact index of backend `b`
 /// (brute: the centres alone), as estimate_memory counts them.
 double sphere_bytes(std::uint64_t asperities, Backend b);
