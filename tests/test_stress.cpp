@@ -446,7 +446,7 @@ TEST(StressCli, OutOfRangeValuesAreCleanErrors) {
                                        {"--speed 1 --omega-x 1e308", "inf"},
                                        {"--speed 1 --omega-y -4e10", "4e+10"},
                                        {"--speed 1e-400", "1e-400"},
-                                       {"--asperities 4294967295 --mode fixed --drops 2", "4294967295"},
+                                       {"--asperities 4294967295 --mode explicit --drops 2", "4294967295"},
                                        // raw samples of 2^31 drops do not fit (automatic statistics would stream them)
                                        {"--drops 2147483648 --statistics raw", "2147483648"},
                                        {"--drops 2147483649", "2147483649"},
@@ -492,7 +492,7 @@ TEST(StressCli, EveryOptionRejectsEmptyNanInfMalformedAndHugeValues) {
     // there too); all five in Release.
     const std::vector<std::string> all{"''", "nan", "-inf", "1e3x", huge}, few{"nan", huge};
     for (const std::string& v : asperity::testing::kSanitized ? few : all) {
-      const std::string extra = opt == "--spheres" ? " --mode fixed" : opt.rfind("--omega", 0) == 0 ? " --speed 1" : "";
+      const std::string extra = opt == "--spheres" ? " --mode explicit" : opt.rfind("--omega", 0) == 0 ? " --speed 1" : "";
       const std::string drops = opt == "--drops" ? "" : " --drops 100";
       const CliResult r = run_cli(opt + " " + v + extra + drops + " --out " + out.string());
       EXPECT_EQ(r.status, 2) << opt << " " << v.substr(0, 20) << "\n" << r.out.substr(0, 300);
@@ -507,7 +507,7 @@ TEST(StressCli, EveryOptionRejectsEmptyNanInfMalformedAndHugeValues) {
 // timings_s object and stage seconds, and the echoed scene file (regexes that must match).
 TEST(StressCli, ReportJsonIdenticalForThreadsAndRepeats) {
   for (const std::string scene : {"--preset fig4 --asperities 3000 --drops 3000",
-                                   "--mode fixed --spheres 3 --drops 3000 --asperities 5000 --backend grid"}) {
+                                   "--mode explicit --spheres 3 --drops 3000 --asperities 5000 --backend grid"}) {
     std::vector<std::string> texts;
     for (const std::string threads : {"1", "2", "2"}) {
       const fs::path out = scratch("repro" + threads);

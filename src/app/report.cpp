@@ -317,7 +317,6 @@ std::string design_note(const GeometryReport& r, const Scene& scene, const Desig
     note << "sampled from the exact finite-N law of the lowest asperity -- no geometry: the two lowest asperities of "
             "each drop are drawn from the order statistics of the polar angle; no sphere is built. Drops are iid.";
   }
-  if (!scene.legacy_mode.empty()) note << " " << legacy_mode_note(scene.legacy_mode);
   return note.str();
 }
 

@@ -532,14 +532,13 @@ void read_asperities(Reader& top, Scene& s) {
              "body.radius: " + num(R) + " m must exceed the asperity radius " + num(s.ensemble.sphere.asperity_radius) + " m");
 }
 
-// ensemble.mode. Earlier names: "fixed" is "explicit"; "fresh" is "explicit" (the paper's sphere:
-// validated from geometry, with a note) or "sampled" (unequal radii: their exact sampler, as before).
+// ensemble.mode; the names removed in 2.0.0 ("fixed", "fresh") are refused saying what to write.
 void read_mode(Reader& ens, Scene& s) {
   auto& e = s.ensemble;
-  if (auto m = ens.choice("mode", {"explicit", "sampled", "fresh", "fixed"})) {
+  if (const auto* m = ens.has("mode") ? ens.find("mode") : nullptr; m && m->as_string())
+    if (const std::string why = removed_mode(m->as_string()->get()); !why.empty()) ens.bad("mode", why);
+  if (auto m = ens.choice("mode", {"explicit", "sampled"})) {
     e.mode = parse_mode(*m);
-    if (*m == "fresh" && s.radii && !s.mesh) e.mode = Mode::sampled;
-    else if (is_legacy_mode(*m)) s.legacy_mode = *m;
   } else if (s.radii && !s.mesh) {
     e.mode = Mode::sampled;  // unequal radii on a sphere: the exact sampler is their only design
   }
@@ -748,7 +747,7 @@ bool read_experiment(Reader& top, Scene& s) {
 void check_experiment(Reader& top, Scene& s, bool impacts) {
   auto& impact = s.ensemble.impact;
   impact.enabled = impacts;
-  if (s.bounce.enabled || s.mesh) s.spheres_auto = false, s.legacy_mode.clear();  // their own designs
+  if (s.bounce.enabled || s.mesh) s.spheres_auto = false;  // their own designs
   if (s.mesh && !impacts && !s.bounce.enabled)
     top.fail(nullptr, "experiment.kind",
              "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega) or \"bounce\"");
@@ -1137,7 +1136,7 @@ void write_asperities(std::ostream& os, const Scene& s) {
 void write_ensemble(std::ostream& os, const Scene& s) {
   const auto& e = s.ensemble;
   // A scene that named a mode by its earlier name is written as it was named (it runs as explicit).
-  os << "[ensemble]\nmode = \"" << (s.legacy_mode.empty() ? to_string(e.mode) : std::string_view(s.legacy_mode))
+  os << "[ensemble]\nmode = \"" << to_string(e.mode)
      << "\"\ndrops = " << e.drops << "\n";
   if (e.mode == Mode::explicit_spheres) {  // sampled drops have no explicit spheres
     if (s.spheres_auto)

@@ -27,19 +27,19 @@ using detail::num;
 std::string_view to_string(Mode m) { return m == Mode::explicit_spheres ? "explicit" : "sampled"; }
 
 Mode parse_mode(std::string_view s) {
-  if (s == "explicit" || s == "fixed" || s == "fresh") return Mode::explicit_spheres;
+  if (s == "explicit") return Mode::explicit_spheres;
   if (s == "sampled") return Mode::sampled;
-  throw std::invalid_argument("unknown mode '" + std::string(s) +
-                              "' (expected explicit or sampled; fixed and fresh are read as explicit)");
+  if (const std::string why = removed_mode(s); !why.empty()) throw std::invalid_argument(why);
+  throw std::invalid_argument("unknown mode '" + std::string(s) + "' (expected explicit or sampled)");
 }
 
-bool is_legacy_mode(std::string_view s) { return s == "fresh" || s == "fixed"; }
-
-std::string legacy_mode_note(std::string_view legacy) {
-  if (legacy == "fixed") return "mode \"fixed\" (earlier name) runs as \"explicit\": K explicit spheres x M rotations.";
-  return "mode \"fresh\" (earlier name: it drew the lowest asperities from the exact law, no geometry) runs as "
-         "\"explicit\": K explicit spheres x M rotations, contacts by spatial query; mode \"sampled\" is the old "
-         "sampler.";
+std::string removed_mode(std::string_view s) {
+  if (s == "fixed")
+    return "mode \"fixed\" was removed in 2.0.0: use \"explicit\" (K explicit spheres x M rotations, the same run)";
+  if (s == "fresh")
+    return "mode \"fresh\" was removed in 2.0.0: use \"explicit\" (explicit spheres, contacts by spatial query, "
+           "as \"fresh\" ran in 1.x) or \"sampled\" (the exact sampler of the lowest asperities, no geometry)";
+  return {};
 }
 
 std::uint64_t auto_spheres(std::uint64_t asperities, std::uint64_t drops) {

@@ -56,11 +56,11 @@ TEST(Cli, BadInputIsAClearErrorWithExitStatus2AndNoFiles) {
       {"--asperity-radius 0", "got 0"},     {"--asperity-radius 0.003", "smaller"},
       {"--asperity-radius 1 --radius 0.5", "smaller"},                       {"--asperity-radius -1e-7", "got -1e-07"},
       {"--drops 0", "got 0"},           {"--drops 1", "must be >= 2"},               {"--drops 1e3.5", "1e3.5"},         {"--drops 2.5", "2.5"},
-      {"--preset fig99", "fig99"},        {"--backend octree --mode fixed", "octree"},
+      {"--preset fig99", "fig99"},        {"--backend octree --mode explicit", "octree"},
       {"--mode frozen", "frozen"},        {"--alpha 0", "alpha"},             {"--alpha 1.5", "alpha"},
       {"--alpha nan", "alpha"},           {"--threads -1", "-1"},             {"--seed -3", "-3"},
-      {"--seed x1", "x1"},                {"--mode fixed --spheres 3 --drops 1000", "multiple"},
-      {"--spheres 0 --mode fixed", "got 0"}, {"--frobnicate 3", "frobnicate"},
+      {"--seed x1", "x1"},                {"--mode explicit --spheres 3 --drops 1000", "multiple"},
+      {"--spheres 0 --mode explicit", "got 0"}, {"--frobnicate 3", "frobnicate"},
       {"--kernel avx", "avx"},            {"--kernel gpu", "CUDA"},
       {"--kernel scalar --mode sampled", "--kernel"},
   };
@@ -346,7 +346,7 @@ TEST(CliScene, LevelRadiiSceneRunsTheRadiiExperiment) {
   EXPECT_TRUE(fs::exists(out / "report.txt"));
   fs::remove_all(out);
   // Command-line overrides that the radii run cannot honour are bad input, not ignored.
-  const CliRun fixed = run("--scene " + scene.string() + " --mode fixed");
+  const CliRun fixed = run("--scene " + scene.string() + " --mode explicit");
   EXPECT_EQ(fixed.status, 2) << fixed.out;
   EXPECT_NE(fixed.out.find("mode"), std::string::npos) << fixed.out;
   EXPECT_FALSE(fs::exists(out));
@@ -358,7 +358,7 @@ TEST(CliScene, MeshSceneRunsMeshImpactsAndExportsPly) {
   const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
   const fs::path scene = write_scene("mesh", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
                                                  "\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[asperities]\ncount = 2000\n"
-                                                 "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 200\n"
+                                                 "[ensemble]\nmode = \"explicit\"\nspheres = 2\ndrops = 200\n"
                                                  "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n"
                                                  "[outputs]\nplots = false\nexport_ply = \"m.ply\"\n"
                                                  "dir = \"" + out.string() + "\"\n");
@@ -372,7 +372,7 @@ TEST(CliScene, MeshSceneRunsMeshImpactsAndExportsPly) {
   fs::remove_all(out);
   // A mesh file that does not exist: exit 2 naming the key and the value, nothing written.
   const fs::path bad = write_scene("badmesh", "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"nope.off\"\n"
-                                              "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 200\n"
+                                              "[ensemble]\nmode = \"explicit\"\nspheres = 2\ndrops = 200\n"
                                               "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0, 0, 0]\n"
                                               "[outputs]\nplots = false\ndir = \"" + out.string() + "\"\n");
   const CliRun b = run("--scene " + bad.string());
@@ -421,7 +421,7 @@ fs::path mesh_scene(const fs::path& out, const std::string& extra_asperities = k
   const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
   return write_scene("mesh-hdr", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
                                      "\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[asperities]\ncount = 2000\n" + extra_asperities +
-                                     "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 200\n"
+                                     "[ensemble]\nmode = \"explicit\"\nspheres = 2\ndrops = 200\n"
                                      "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n"
                                      "[outputs]\nplots = false\ndir = \"" + out.string() + "\"\n");
 }
@@ -507,12 +507,12 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
       {"--mode sampled --backend grid", "--backend: ensemble.backend: only mode = \"explicit\" queries a contact index"},
       {"--mode sampled --spheres 4", "--spheres: ensemble.spheres: only mode = \"explicit\" uses explicit spheres"},
       {"--preset fig6 --drops 100", "--drops: not used by a bounce run"},
-      {"--preset fig6 --mode fixed", "--mode: not used by a bounce run"},
+      {"--preset fig6 --mode explicit", "--mode: not used by a bounce run"},
       {"--preset fig6 --alpha 0.05", "--alpha: not used by a bounce run"},
       {"--preset fig6 --omega-x 1", "--omega-x: not used by a bounce run"},
       {"--preset fig6 --spheres 2", "--spheres: not used by a bounce run"},
       {"--preset fig6 --backend grid", "--backend: not used by a bounce run"},
-      {L + " --mode fixed", "--mode: ensemble.mode: unequal asperity radii on a sphere draw from their exact sampler"},
+      {L + " --mode explicit", "--mode: ensemble.mode: unequal asperity radii on a sphere draw from their exact sampler"},
       {L + " --speed 1", "--speed: a run with unequal asperity radii on a sphere"},
       {L + " --omega-y 1", "--omega-y: a run with unequal asperity radii on a sphere"},
       {L + " --backend grid", "--backend: ensemble.backend: only mode = \"explicit\" queries a contact index"},
@@ -545,9 +545,9 @@ TEST(CliReport, OptionsThatCannotApplyAreErrors) {
   }
   // What does apply still runs: --spheres and --backend in fixed mode, --speed on a mesh, --mode
   // fixed on a level-radii scene once --asperity-radius made it the paper's run.
-  for (const std::string& ok : std::vector<std::string>{"--mode fixed --spheres 2 --backend grid --asperities 500 --drops 200",
+  for (const std::string& ok : std::vector<std::string>{"--mode explicit --spheres 2 --backend grid --asperities 500 --drops 200",
                                M + " --speed 1 --omega-x 0.1 --spheres 1",
-                               L + " --asperity-radius 1e-6 --mode fixed --spheres 3 --drops 300",
+                               L + " --asperity-radius 1e-6 --mode explicit --spheres 3 --drops 300",
                                "--preset fig4 --asperities 1000 --drops 400 --tangential coulomb:mu=0.3,restitution=poisson",
                                "--preset fig6 --variant dynamic --sequences 20 --asperities 10000 --tangential walton:mu=0.3,beta0=0.5"}) {
     const CliRun r = run(ok + " --no-plots --out " + out.string());
@@ -663,7 +663,7 @@ TEST(CliReport, AFailedReportWriteRemovesWhatTheRunWrote) {
   const fs::path out = fresh_dir("failwrite");
   const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
   const fs::path scene = write_scene("failwrite", "format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
-                                                      "\"\n[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\n"
+                                                      "\"\n[asperities]\ncount = 500\n[ensemble]\nmode = \"explicit\"\n"
                                                       "spheres = 2\ndrops = 100\n[experiment]\nkind = \"impact\"\n"
                                                       "V = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n[outputs]\nplots = false\n"
                                                       "export_ply = \"m.ply\"\ndir = \"" + out.string() + "\"\n");
@@ -690,7 +690,7 @@ TEST(CliScene, MeshBounceSceneRunsBounceSequences) {
   const std::string mesh = std::string(SCENES_DIR) + "/../meshes/ellipsoid.off";
   const fs::path scene = write_scene("mb", "format = 1\nname = \"mb\"\n[body]\nkind = \"mesh\"\nmesh = \"" + mesh +
                                                "\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[asperities]\ncount = 3000\n"
-                                               "[ensemble]\nmode = \"fixed\"\nspheres = 2\n"
+                                               "[ensemble]\nmode = \"explicit\"\nspheres = 2\n"
                                                "[experiment]\nkind = \"bounce\"\nspeed = 0.5\nstop_speed = 0.2\n"
                                                "sequences = 6\nOmega = [1.0, 0.0, 0.0]\n"
                                                "[outputs]\nplots = true\ndir = \"" + out.string() + "\"\n");

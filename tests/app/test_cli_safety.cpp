@@ -188,13 +188,13 @@ struct Refusal {
 std::string mesh_scene(const std::string& body_extra, const std::string& extra = "") {
   return "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"" + std::string(SCENES_DIR) + "/../meshes/ellipsoid.off\"\n" +
          body_extra + "[asperities]\ncount = 500\n" + extra +
-         "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 100\n"
+         "[ensemble]\nmode = \"explicit\"\nspheres = 2\ndrops = 100\n"
          "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n[outputs]\nplots = false\n";
 }
 
 std::string mesh_bounce_scene() {
   return "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"" + std::string(SCENES_DIR) + "/../meshes/ellipsoid.off\"\n"
-         "[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\nspheres = 2\n"
+         "[asperities]\ncount = 500\n[ensemble]\nmode = \"explicit\"\nspheres = 2\n"
          "[experiment]\nkind = \"bounce\"\nspeed = 0.5\nstop_speed = 0.2\nsequences = 2\n[outputs]\nplots = false\n";
 }
 
@@ -515,7 +515,7 @@ TEST(CliHostileNames, MeshAndOutputNamesRunNothingAndStayInTheOutput) {
   const fs::path mesh = cwd / (payload + ".off");
   fs::copy_file(fs::path(SCENES_DIR) / ".." / "meshes" / "ellipsoid.off", mesh);
   const std::string body = "format = 1\n[body]\nkind = \"mesh\"\nmesh = " + toml_string(mesh.string()) +
-                           "\n[asperities]\ncount = 500\n[ensemble]\nmode = \"fixed\"\nspheres = 2\n";
+                           "\n[asperities]\ncount = 500\n[ensemble]\nmode = \"explicit\"\nspheres = 2\n";
   const std::vector<std::pair<std::string, std::string>> scenes = {
       {"impact", body + "drops = 200\n[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n"},
       {"bounce", body + "[experiment]\nkind = \"bounce\"\nspeed = 0.5\nstop_speed = 0.2\nsequences = 40\n"}};

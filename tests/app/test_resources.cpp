@@ -154,26 +154,26 @@ const char* kImpact = "drops = 100\nseed = 1\n[experiment]\nkind = \"impact\"\nV
 
 // Sphere runs: one sphere per index; the planner's two choices (brute below 32 rotations, grid).
 TEST(ResourcesPeak, OneSphereGrid) {
-  expect_estimate_near_peak("grid", {"--mode", "fixed", "--spheres", "1", "--asperities", "1000000", "--drops", "100", "--threads", "1"});
+  expect_estimate_near_peak("grid", {"--mode", "explicit", "--spheres", "1", "--asperities", "1000000", "--drops", "100", "--threads", "1"});
 }
 TEST(ResourcesPeak, OneSphereBruteAsPlanned) {
-  expect_estimate_near_peak("brute", {"--mode", "fixed", "--spheres", "1", "--asperities", "1000000", "--drops", "10", "--threads", "1"});
+  expect_estimate_near_peak("brute", {"--mode", "explicit", "--spheres", "1", "--asperities", "1000000", "--drops", "10", "--threads", "1"});
 }
 TEST(ResourcesPeak, OneSphereKdtree) {
-  expect_estimate_near_peak("kdtree", {"--mode", "fixed", "--spheres", "1", "--asperities", "1000000", "--drops", "100",
+  expect_estimate_near_peak("kdtree", {"--mode", "explicit", "--spheres", "1", "--asperities", "1000000", "--drops", "100",
                                        "--threads", "1", "--backend", "kdtree"});
 }
 TEST(ResourcesPeak, OneSphereCgal) {
-  expect_estimate_near_peak("cgal", {"--mode", "fixed", "--spheres", "1", "--asperities", "300000", "--drops", "10", "--threads",
+  expect_estimate_near_peak("cgal", {"--mode", "explicit", "--spheres", "1", "--asperities", "300000", "--drops", "10", "--threads",
                                      "1", "--backend", "cgal"});
 }
 TEST(ResourcesPeak, OneSphereFcl) {
-  expect_estimate_near_peak("fcl", {"--mode", "fixed", "--spheres", "1", "--asperities", "100000", "--drops", "10", "--threads",
+  expect_estimate_near_peak("fcl", {"--mode", "explicit", "--spheres", "1", "--asperities", "100000", "--drops", "10", "--threads",
                                     "1", "--backend", "fcl"});
 }
 // Many small spheres: one per busy thread.
 TEST(ResourcesPeak, SpheresOnePerThread) {
-  expect_estimate_near_peak("per-thread", {"--mode", "fixed", "--spheres", "4", "--asperities", "500000", "--drops", "32", "--threads", "2"});
+  expect_estimate_near_peak("per-thread", {"--mode", "explicit", "--spheres", "4", "--asperities", "500000", "--drops", "32", "--threads", "2"});
 }
 // Fresh drops: per drop.
 TEST(ResourcesPeak, SampledDrops) { expect_estimate_near_peak("sampled", {"--asperities", "1000", "--drops", "1000000"}); }
@@ -212,6 +212,19 @@ TEST(ResourcesPeak, BouncePaper) {
 TEST(ResourcesPeak, BounceExplicit) {
   expect_estimate_near_peak("bounce-dynamic", {"--preset", "fig6", "--variant", "dynamic", "--asperities", "10000", "--sequences", "8000", "--threads", "1"});
 }
+// Sequences that never slow to their stop speed run to max_impacts (1e5 each): the block of
+// sequences run_bounces holds before appending them is as big as the impacts it keeps (issue 43:
+// estimated 13x low before).
+TEST(ResourcesPeak, BounceToMaxImpacts) {
+  const fs::path f = inputs() / "bounce-max-impacts.toml";
+  std::string text(asperity::preset_text("fig6"));
+  const std::string stop = "stop_speed = 0.1", seq = "sequences = 100000", var = "variants = \"paper,random-orientation,dynamic\"";
+  text.replace(text.find(stop), stop.size(), "stop_speed = 1e-300");
+  text.replace(text.find(seq), seq.size(), "sequences = 4");
+  text.replace(text.find(var), var.size(), "variants = \"dynamic\"");
+  std::ofstream(f) << text;
+  expect_estimate_near_peak("bounce-max-impacts", {"--scene", f.string(), "--asperities", "1000", "--threads", "1"});
+}
 // Mesh-body bounces: every body kept.
 TEST(ResourcesPeak, MeshBounce) {
   const fs::path f = mesh_scene("mesh-bounce", uv_mesh(20, 32),
@@ -238,7 +251,7 @@ TEST(Resources, RunsThatDoNotFitAreRefusedBeforeTheyStart) {
   // (A sanitized binary cannot start under ulimit -v: its shadow memory alone exceeds the limit.)
 #ifndef ASPERITY_SANITIZED
   r = asperity::testing::run_command("ulimit -v 2000000; " + std::string(VALIDATE_GEOMETRY) +
-                                     " --mode fixed --asperities 5e7 --drops 1000 --out /nonexistent/never 2>&1");
+                                     " --mode explicit --asperities 5e7 --drops 1000 --out /nonexistent/never 2>&1");
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("50000000 asperities"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("2.05 GB this process may use"), std::string::npos) << r.out;

@@ -32,7 +32,7 @@ Scene levels_scene(const std::string& radius) {
 Scene mesh_scene() {
   return scene_of("format = 1\nname = \"m\"\n[body]\nkind = \"mesh\"\nmesh = \"" + std::string(ASPERITY_MESH_DIR) +
                   "/ellipsoid.off\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[asperities]\ncount = 2000\n"
-                  "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 40000\n"
+                  "[ensemble]\nmode = \"explicit\"\nspheres = 2\ndrops = 40000\n"
                   "[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\nOmega = [0.2, 0, 0]\n" + kOutputs);
 }
 

@@ -66,7 +66,7 @@ restitution = { model = "viscoelastic", beta = 0.0467 }
 count = 1000
 radius = { distribution = "fixed", value = 6.5e-7 }
 [ensemble]
-mode = "fixed"
+mode = "explicit"
 drops = 2000
 spheres = 10
 seed = 7
@@ -134,8 +134,7 @@ TEST(SceneFile, EveryPresetFileEqualsThePresetAsDefinedInCode) {
 TEST(SceneFile, RoundTripsThroughToToml) {
   std::vector<Scene> scenes;
   for (const auto& name : preset_names()) scenes.push_back(preset(name));
-  // (kGood names the earlier mode "fixed": its note is about the file, to_toml writes "explicit".)
-  const std::string good = replace(kGood, "mode = \"fixed\"", "mode = \"explicit\"");
+  const std::string good = kGood;
   scenes.push_back(parse_scene(good));
   Scene odd = parse_scene(good);
   odd.name = "quote \" backslash \\ tab \t";
@@ -211,7 +210,7 @@ TEST(SceneFile, WrongTypesAreErrorsNamingKeyAndValue) {
   expect_error(replace(kGood, "count = 1000", "count = \"1000\""), "asperities.count", "\"1000\"");
   expect_error(replace(kGood, "count = 1000", "count = 1000.5"), "asperities.count", "1000.5");
   expect_error(replace(kGood, "plots = false", "plots = 0"), "outputs.plots", "0");
-  expect_error(replace(kGood, "mode = \"fixed\"", "mode = 1"), "ensemble.mode");
+  expect_error(replace(kGood, "mode = \"explicit\"", "mode = 1"), "ensemble.mode");
   expect_error(replace(kGood, "V = [0.0, 0.0, -1.3]", "V = [0.0, -1.3]"), "experiment.V");
   expect_error(replace(kGood, "V = [0.0, 0.0, -1.3]", "V = [0.0, \"a\", -1.3]"), "experiment.V", "\"a\"");
   expect_error(replace(kGood, "[body]\nkind", "body = 3\n[bodyx]\nkind"), "body", "3");
@@ -246,17 +245,16 @@ TEST(SceneFile, NanInfAndOutOfRangeValuesAreErrorsNamingKeyAndValue) {
   expect_error(replace(kGood, "report = \"report.json\"", "report = \"../x.json\""), "outputs.report", "../x.json");
   expect_error(replace(kGood, "format = 1", "format = 2"), "format", "2");
   expect_error("name = \"x\"\n", "format");
-  expect_error(replace(kGood, "mode = \"fixed\"", "mode = \"frozen\""), "ensemble.mode", "frozen");
+  expect_error(replace(kGood, "mode = \"explicit\"", "mode = \"frozen\""), "ensemble.mode", "frozen");
   expect_error(replace(kGood, "backend = \"auto\"", "backend = \"octree\""), "ensemble.backend", "octree");
   // A backend for sampled drops would be ignored: refused, naming the key and the value.
-  const std::string fresh = replace(replace(kGood, "mode = \"fixed\"", "mode = \"sampled\""), "spheres = 10", "spheres = 1");
+  const std::string fresh = replace(replace(kGood, "mode = \"explicit\"", "mode = \"sampled\""), "spheres = 10", "spheres = 1");
   EXPECT_NO_THROW(parse_scene(fresh));
   expect_error(replace(fresh, "backend = \"auto\"", "backend = \"grid\""), "ensemble.backend", "grid");
-  expect_error(replace(kGood, "mode = \"fixed\"", "mode = \"sampled\""), "ensemble.spheres", "sampled");
-  // The earlier names still read: fixed and fresh run as explicit, and say so.
-  const Scene legacy = parse_scene(replace(kGood, "mode = \"fixed\"", "mode = \"fresh\""));
-  EXPECT_EQ(legacy.ensemble.mode, Mode::explicit_spheres);
-  EXPECT_EQ(legacy.legacy_mode, "fresh");
+  expect_error(replace(kGood, "mode = \"explicit\"", "mode = \"sampled\""), "ensemble.spheres", "sampled");
+  // The names removed in 2.0.0 are refused, saying what to write instead.
+  expect_error(replace(kGood, "mode = \"explicit\"", "mode = \"fresh\""), "ensemble.mode", "\"sampled\"");
+  expect_error(replace(kGood, "mode = \"explicit\"", "mode = \"fixed\""), "ensemble.mode", "use \"explicit\"");
   EXPECT_EQ(parse_scene(kGood).ensemble.mode, Mode::explicit_spheres);
   EXPECT_TRUE(parse_scene(replace(kGood, "spheres = 10", "spheres = \"auto\"")).spheres_auto);
   expect_error(replace(kGood, "spheres = 10", "spheres = \"many\""), "ensemble.spheres", "many");
@@ -269,7 +267,7 @@ TEST(SceneFile, NanInfAndOutOfRangeValuesAreErrorsNamingKeyAndValue) {
 TEST(SceneFile, EmptyStringsAreErrorsNamingTheKey) {
   expect_error(replace(kGood, "name = \"tiny\"", "name = \"\""), "name");
   expect_error(replace(kGood, "kind = \"sphere\"", "kind = \"\""), "body.kind");
-  expect_error(replace(kGood, "mode = \"fixed\"", "mode = \"\""), "ensemble.mode");
+  expect_error(replace(kGood, "mode = \"explicit\"", "mode = \"\""), "ensemble.mode");
   expect_error(replace(kGood, "dir = \"out\"", "dir = \"\""), "outputs.dir");
   expect_error(replace(kGood, "report = \"report.json\"", "report = \"\""), "outputs.report");
   expect_error(replace(kGood, "backend = \"auto\"", "backend = \"\""), "ensemble.backend");
@@ -349,7 +347,7 @@ smooth = [4e-3, 3e-3, 2.25e-3]
 count = 2000
 radius = { distribution = "fixed", value = 6.5e-7 }
 [ensemble]
-mode = "fixed"
+mode = "explicit"
 spheres = 2
 drops = 200
 [experiment]
@@ -464,12 +462,12 @@ TEST(SceneFileBodies, BadKeysInTheNewSectionsNameTheKeyAndValue) {
                "outputs.export_style", "dots");
   expect_error(replace(kMesh, "export_ply = \"m.ply\"", "export_style = \"points\""), "outputs.export_style", "export_ply");
   // Combinations the runs cannot honour are refused, naming the key.
-  expect_error(replace(kMesh, "mode = \"fixed\"\nspheres = 2", "mode = \"sampled\""), "ensemble.mode", "explicit");
+  expect_error(replace(kMesh, "mode = \"explicit\"\nspheres = 2", "mode = \"sampled\""), "ensemble.mode", "explicit");
   expect_error(replace(kMesh, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"contact\""),
                "experiment.kind", "impact");
   expect_error(replace(kMesh, "count = 2000", "areal_density = 1e10"), "asperities.areal_density", "count");
   expect_error(replace(kLevels, "seed = 3", "seed = 3\nbackend = \"grid\""), "ensemble.backend", "grid");
-  expect_error(replace(kLevels, "drops = 3000", "drops = 3000\nmode = \"fixed\""), "ensemble.mode", "explicit");
+  expect_error(replace(kLevels, "drops = 3000", "drops = 3000\nmode = \"explicit\""), "ensemble.mode", "explicit");
   expect_error(replace(kLevels, "drops = 3000", "drops = 3000\nmode = \"explicit\""), "ensemble.mode", "sampled");
   // Every kind of run writes its report through the same writer: the report name is free.
   EXPECT_EQ(parse_scene(replace(kLevels, "plots = false", "plots = false\nreport = \"x.json\""), "t").report, "x.json");

@@ -27,7 +27,7 @@ std::string mesh_scene(const std::string& material) {
   return "format = 1\n[body]\nkind = \"mesh\"\nmesh = \"" + (kMeshes / "ellipsoid.off").string() +
          "\"\nsmooth = [4e-3, 3e-3, 2.25e-3]\n[material]\n" + material +
          "\n[asperities]\ncount = 2000\nradius = { distribution = \"fixed\", value = 6.5e-7 }\n"
-         "[ensemble]\nmode = \"fixed\"\nspheres = 2\ndrops = 400\n[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\n"
+         "[ensemble]\nmode = \"explicit\"\nspheres = 2\ndrops = 400\n[experiment]\nkind = \"impact\"\nV = [0, 0, -1.3]\n"
          "Omega = [0.2, 0, 0]\n[outputs]\nplots = false\n";
 }
 

@@ -94,14 +94,14 @@ def test_exception_in_progress_propagates(small_scene):
         raise Stop(f"{done}/{total}")
 
     with pytest.raises(Stop):
-        asperity.run(small_scene(drops=200000, mode="fixed", spheres=2), progress=progress)
+        asperity.run(small_scene(drops=200000, mode="explicit", spheres=2), progress=progress)
 
 
 def test_ctrl_c_interrupts(small_scene):
     # SIGINT delivered to this process while the run computes (GIL released): KeyboardInterrupt
     # at the next progress step, long before the run would have finished (load-independent: the
     # drops done when it stopped are counted, not seconds).
-    scene = small_scene(drops=1_000_000, mode="fixed", spheres=1, count=20_000, backend="brute")
+    scene = small_scene(drops=1_000_000, mode="explicit", spheres=1, count=20_000, backend="brute")
     done = []
     timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()

@@ -71,9 +71,6 @@ struct Scene {
   /// ensemble.spheres was not chosen (explicit design): the planner takes K from the error budget
   /// (auto_spheres, ensemble.hpp). Scene files write it as spheres = "auto".
   bool spheres_auto = true;
-  /// "fresh" or "fixed" when the scene named its mode by an earlier name (it runs as explicit; the
-  /// report says so, legacy_mode_note); to_toml writes the name back. Empty otherwise.
-  std::string legacy_mode;
   double alpha = 0.01;        ///< significance level of each test and of the family (Holm: the exit status)
   bool plots = true;          ///< write figures with their data as CSV (needs PLplot)
   /// outputs.plot_format (--plot-format): png, svg, pdf, png+svg, png+pdf (app/plot.hpp

@@ -31,15 +31,12 @@ namespace asperity {
 enum class Mode { explicit_spheres, sampled };
 /// "explicit" or "sampled".
 std::string_view to_string(Mode m);
-/// "explicit" or "sampled". The names of scene files before issue 13 are accepted: "fixed" (K
-/// explicit spheres x M rotations) is "explicit"; "fresh" (it drew from the exact law, no sphere)
-/// is "explicit" too -- a law is validated from geometry unless "sampled" is asked for -- and the
-/// report says so (legacy_mode_note). Throws std::invalid_argument naming the value otherwise.
+/// "explicit" or "sampled". Throws std::invalid_argument naming the value otherwise; for the
+/// names removed in 2.0.0 ("fixed", "fresh") the message says what to write instead (removed_mode).
 Mode parse_mode(std::string_view s);
-/// True for "fresh" and "fixed", the names of earlier versions.
-bool is_legacy_mode(std::string_view s);
-/// The sentence a report carries when a scene named a legacy mode.
-std::string legacy_mode_note(std::string_view legacy);
+/// For "fixed" and "fresh", the mode names of versions before 2.0.0: why they are refused and
+/// which name to use ("explicit"; for "fresh" also "sampled"). Empty for any other text.
+std::string removed_mode(std::string_view s);
 
 /// KS-scale constant of the quenched deviation: one fixed sphere's orientation-averaged law of
 /// r_xy differs from the ensemble law by E sup_t |F_sphere(t) - F(t)| ~ kQuenchedKs / sqrt(N)

@@ -73,6 +73,11 @@ inline constexpr double kBaseSphere = 10.6e6;  ///< the process with its librari
 inline constexpr double kPerDropFresh = 49;    ///< contact samples per drop
 inline constexpr double kPerDropImpact = 92;   ///< + eps, Omega' (fresh or fixed)
 
+/// Impacts of one bounce sequence from b.speed down to b.stop_speed (bounce.cpp, the runs' one):
+/// Eq. 9 to leading order, 1 - eps = c u^(1/5), gives k(u) = 5 / c (u_stop^(-1/5) - u_1^(-1/5)),
+/// capped at b.max_impacts (a stop speed far below 1e-10 m/s is never reached sooner).
+double bounce_impacts(const BounceExperiment& b);
+
 // The rows (one file each).
 extern const Kind kSphere, kRadii, kMesh, kBounce, kMeshBounce;
 

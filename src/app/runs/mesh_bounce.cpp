@@ -25,14 +25,13 @@ MeshBounceExperiment mesh_bounce_experiment(const Scene& s) {
   return m;
 }
 
-constexpr double kPerImpactBounce = 64;     // one impact of a sequence, kept for the analysis (measured)
-constexpr double kImpactsPerDecade = 55.5;  // fig6: 55.5 impacts from 1 m/s down to 0.1 m/s
+constexpr double kPerImpactBounce = 64;  // one impact of a sequence, kept for the analysis (measured)
 
 double estimate(const Plan& p, std::ostringstream& d) {
   const Scene& s = p.given;
   const auto& e = s.ensemble;
   const double K = double(e.spheres), N = double(e.sphere.asperities);
-  const double impacts = kImpactsPerDecade * std::log10(s.bounce.speed / s.bounce.stop_speed);
+  const double impacts = bounce_impacts(s.bounce);
   const double seq = double(s.bounce.sequences);
   d << e.spheres << " bodies kept x " << e.sphere.asperities << " asperities x " << kPerAsperityMesh << " B + "
     << s.bounce.sequences << " sequences x ~" << fmt3(impacts) << " impacts x " << kPerImpactBounce << " B";
