@@ -164,14 +164,13 @@ void validate_bounce(const Scene& s) {
 void validate_mesh_run(const Scene& s) {
   if (s.mesh->file.empty()) throw std::invalid_argument("mesh file must not be empty");
   if (s.ensemble.mode != Mode::explicit_spheres)
-    throw std::invalid_argument("a mesh body needs mode explicit (explicit bodies x rotations), got " +
-                                std::string(to_string(s.ensemble.mode)));
+    throw std::invalid_argument("ensemble.mode: a mesh body needs mode = \"explicit\" (ensemble.spheres explicit bodies x "
+                                "rotations), got \"" + std::string(to_string(s.ensemble.mode)) + "\"");
   if (s.ensemble.impact.enabled == s.bounce.enabled)
-    throw std::invalid_argument("a mesh body runs single impacts or bounce sequences: it needs an impact or a bounce "
-                                "experiment");
+    throw std::invalid_argument("experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega) or \"bounce\"");
   if (s.bounce.enabled && s.bounce.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
-    throw std::invalid_argument("a mesh body bounces with its orientation carried by the free rotation: variants must "
-                                "be \"dynamic\" only");
+    throw std::invalid_argument("experiment.variants: a mesh body bounces with its orientation carried by the free "
+                                "rotation: only \"dynamic\"");
   // Standard errors between bodies (batch means) need two rotations of each: refused before
   // the run, not found after it.
   const auto K = s.ensemble.spheres, n = s.ensemble.drops;
@@ -193,10 +192,12 @@ void validate_radii_run(const Scene& s) {
   if (!(top < R))
     throw std::invalid_argument("asperity radii " + d.describe() + " must be smaller than radius = " + detail::num(R) + " m");
   if (s.ensemble.mode != Mode::sampled)
-    throw std::invalid_argument("unequal asperity radii on a sphere need mode sampled (their exact sampler), got " +
-                                std::string(to_string(s.ensemble.mode)));
+    throw std::invalid_argument("ensemble.mode: unequal asperity radii on a sphere draw from their exact sampler (mode = "
+                                "\"sampled\") and screen [screening] bodies explicit ones, got \"" +
+                                std::string(to_string(s.ensemble.mode)) + "\"");
   if (s.ensemble.impact.enabled || s.bounce.enabled)
-    throw std::invalid_argument("unequal asperity radii on a sphere are analysed as contacts only (no impacts)");
+    throw std::invalid_argument("experiment.kind: unequal asperity radii on a sphere are analysed as contacts only; use "
+                                "kind = \"contact\"");
   const auto B = s.radii->screen_bodies, n = s.ensemble.drops;
   if (d.kind == RadiusDistribution::Kind::lognormal && B >= 2 && n / B < 2)
     throw std::invalid_argument("ensemble.drops (--drops): " + std::to_string(n) + " drops over screening.bodies = " +

@@ -614,19 +614,12 @@ void read_ensemble(Reader& top, Scene& s) {
 }
 
 // Mesh bodies and unequal radii are runs of body_experiments.hpp: explicit bodies with the exact
-// support tree, so the ensemble keys that choose a contact backend or a mode do not apply.
-// Bodies, radii and bounce runs choose their own number of bodies: K is never automatic there.
+// support tree, so the ensemble keys that choose a contact backend do not apply (their modes:
+// validate(Scene), scene.cpp). Bodies, radii and bounce runs choose their own number of bodies: K
+// is never automatic there.
 void check_body_ensemble(Reader& top, Scene& s) {
   const auto& e = s.ensemble;
   if (s.mesh || s.radii || s.bounce.enabled) s.spheres_auto = false;
-  if (s.mesh && e.mode != Mode::explicit_spheres)
-    top.fail(nullptr, "ensemble.mode",
-             "ensemble.mode: a mesh body needs mode = \"explicit\" (ensemble.spheres explicit bodies x rotations), got \"" +
-                 std::string(to_string(e.mode)) + "\"");
-  if (s.radii && !s.mesh && e.mode != Mode::sampled)
-    top.fail(nullptr, "ensemble.mode",
-             "ensemble.mode: unequal asperity radii on a sphere draw from their exact sampler (mode = \"sampled\") and screen "
-             "[screening] bodies explicit ones, got \"" + std::string(to_string(e.mode)) + "\"");
   if ((s.mesh || s.radii) && !s.backend_auto)
     top.fail(nullptr, "ensemble.backend",
              "ensemble.backend: mesh bodies and unequal asperity radii use the exact support tree; only \"auto\", got \"" +
@@ -695,11 +688,10 @@ void read_bounce(Reader& ex, Scene& s) {
   read_bounce_groups(ex, b);
   if (!(b.stop_speed < b.speed))
     ex.bad("stop_speed", "must be below speed = " + num(b.speed) + " m/s, got " + num(b.stop_speed));
-  // A body bounces one way: its orientation carried by the free rotation (body_bounce.hpp).
+  // A body bounces one way, its orientation carried by the free rotation (body_bounce.hpp): its
+  // default; any other variant is refused by validate(Scene).
   if (s.mesh) {
-    if (ex.has("variants") && b.variants != std::vector<BounceVariant>{BounceVariant::dynamic})
-      ex.bad("variants", "a mesh body bounces with its orientation carried by the free rotation: only \"dynamic\"");
-    b.variants = {BounceVariant::dynamic};
+    if (!ex.has("variants")) b.variants = {BounceVariant::dynamic};
     if (const auto W = ex.vec3("Omega", "rad/s")) b.omega = *W;
   } else if (ex.has("Omega")) {
     ex.bad("Omega", "only for body.kind = \"mesh\": the sphere's bounce variants start without spin (Sec. V)");
@@ -748,14 +740,8 @@ void check_experiment(Reader& top, Scene& s, bool impacts) {
   auto& impact = s.ensemble.impact;
   impact.enabled = impacts;
   if (s.bounce.enabled || s.mesh) s.spheres_auto = false;  // their own designs
-  if (s.mesh && !impacts && !s.bounce.enabled)
-    top.fail(nullptr, "experiment.kind",
-             "experiment.kind: a mesh body needs kind = \"impact\" (with V and Omega) or \"bounce\"");
   if (s.mesh && impacts && s.ensemble.drops % s.ensemble.spheres != 0)
     top.fail(nullptr, "ensemble.drops", "ensemble.drops: must be a multiple of ensemble.spheres");
-  if (s.radii && !s.mesh && (impacts || s.bounce.enabled))
-    top.fail(nullptr, "experiment.kind",
-             "experiment.kind: unequal asperity radii on a sphere are analysed as contacts only; use kind = \"contact\"");
   if (s.bounce.enabled) {  // the material applies to every impact of a sequence
     s.bounce.density = impact.density, s.bounce.beta = impact.beta, s.bounce.eps_t = impact.eps_t;
   }
@@ -812,12 +798,7 @@ void read_outputs(Reader& top, Scene& s, bool impacts) {
   read_output_files(*out, s);
   if (s.mesh && !(s.contact_stats && s.restitution_stats))
     out->bad(s.contact_stats ? "restitution" : "contact", "a mesh body's run always analyses contacts and restitution");
-  if (auto ct = out->table("cor_table")) {
-    if (s.mesh || s.radii || s.bounce.enabled || !impacts)
-      out->bad("cor_table", "only for a sphere impact scene (body.kind = \"sphere\", experiment.kind = \"impact\", "
-                            "one asperity radius)");
-    s.cor_table = read_cor_table(*ct);
-  }
+  if (auto ct = out->table("cor_table")) s.cor_table = read_cor_table(*ct);  // which runs: validate(Scene)
   out->finish();
 }
 
