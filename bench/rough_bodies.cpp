@@ -22,7 +22,7 @@
 #include "asperity/experiments/body_experiments.hpp"
 #include "asperity/core/mesh.hpp"
 #include "asperity/app/experiment_reports.hpp"
-#include "asperity/app/mesh_io.hpp"
+#include "app/io/mesh_io.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/core/random.hpp"

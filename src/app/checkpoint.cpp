@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "asperity/app/checkpoint.hpp"
+#include "app/checkpoint.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -15,7 +15,7 @@
 #include <system_error>
 #include <type_traits>
 
-#include "asperity/app/atomic_file.hpp"
+#include "app/io/atomic_file.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/scene_file.hpp"
 
@@ -226,13 +226,6 @@ std::string checkpoint_key(const Plan& p) {
 std::string checkpoint_state_name(const StreamShare& share) {
   if (share.ranks <= 1) return kCheckpointState;
   return "checkpoint.rank-" + std::to_string(share.rank) + "-of-" + std::to_string(share.ranks) + ".bin";
-}
-
-bool is_checkpoint_name(std::string_view n) {
-  constexpr std::string_view rank = "checkpoint.rank-", bin = ".bin";
-  if (n == kCheckpointScene || n == kCheckpointState) return true;
-  return n.size() >= rank.size() + bin.size() && n.substr(0, rank.size()) == rank &&
-         n.substr(n.size() - bin.size()) == bin && n.find("-of-") != std::string_view::npos;
 }
 
 void write_checkpoint(const fs::path& dir, const Plan& p, const StreamState& st) {

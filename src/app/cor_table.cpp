@@ -12,7 +12,7 @@
 #include <tuple>
 #include <utility>
 
-#include "asperity/app/atomic_file.hpp"
+#include "app/io/atomic_file.hpp"
 #include "asperity/config.hpp"
 #include "asperity/core/restitution.hpp"
 #include "asperity/cor_table.h"

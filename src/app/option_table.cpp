@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "asperity/app/option_table.hpp"
+#include "app/option_table.hpp"
 
 #include <array>
 #include <cctype>

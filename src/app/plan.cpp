@@ -4,7 +4,7 @@
 #include <atomic>
 #include <stdexcept>
 
-#include "asperity/app/checkpoint.hpp"
+#include "app/checkpoint.hpp"
 #include "asperity/app/resources.hpp"
 #include "app/runs/kinds.hpp"
 #include "app/runs/mesh_body.hpp"

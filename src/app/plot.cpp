@@ -18,7 +18,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "asperity/app/interrupt.hpp"
+#include "app/io/interrupt.hpp"
 #include "plot_render.hpp"
 
 namespace asperity {

@@ -2,7 +2,7 @@
 #include "checked_text.hpp"
 #include "asperity/app/report.hpp"
 
-#include "asperity/app/atomic_file.hpp"
+#include "app/io/atomic_file.hpp"
 
 #include <boost/math/distributions/binomial.hpp>
 #include <nlohmann/json.hpp>

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <optional>
 
-#include "asperity/app/output_staging.hpp"
+#include "app/io/output_staging.hpp"
 #include "asperity/core/thread_count.hpp"
 #include "app/runs/kinds.hpp"
 

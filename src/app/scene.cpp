@@ -8,10 +8,10 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "asperity/app/output_staging.hpp"
+#include "app/io/output_staging.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "core/format.hpp"
-#include "text_escape.hpp"
+#include "app/io/text_escape.hpp"
 #include "asperity_embedded_scenes.hpp"  // generated from scenes/*.toml (CMakeLists.txt)
 
 namespace asperity {

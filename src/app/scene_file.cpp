@@ -2,10 +2,10 @@
 // Scene files (format 1). toml++ is used header-only, in this translation unit only.
 #include "asperity/app/scene_file.hpp"
 
-#include "asperity/app/bounded_read.hpp"
-#include "asperity/app/output_staging.hpp"
+#include "app/io/bounded_read.hpp"
+#include "app/io/output_staging.hpp"
 #include "asperity/app/plot.hpp"
-#include "text_escape.hpp"
+#include "app/io/text_escape.hpp"
 
 #define TOML_ENABLE_FORMATTERS 0  // we write TOML ourselves (to_toml)
 #include <toml++/toml.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "asperity/app/stream_report.hpp"
+#include "app/stream_report.hpp"
 
 #include <boost/math/distributions/binomial.hpp>
 
@@ -16,8 +16,8 @@
 #include <numbers>
 #include <sstream>
 
-#include "asperity/app/checkpoint.hpp"
-#include "asperity/app/interrupt.hpp"
+#include "app/checkpoint.hpp"
+#include "app/io/interrupt.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/laws/binned.hpp"

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "asperity/app/atomic_file.hpp"
-#include "asperity/app/checkpoint.hpp"
-#include "asperity/app/output_staging.hpp"
+#include "app/io/atomic_file.hpp"
+#include "app/checkpoint.hpp"
+#include "app/io/output_staging.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "checkpoint_fixture.hpp"
 #include "run_command.hpp"

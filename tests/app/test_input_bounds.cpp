@@ -13,9 +13,9 @@
 #include <fstream>
 #include <string>
 
-#include "asperity/app/bounded_read.hpp"
-#include "asperity/app/mesh_io.hpp"
-#include "asperity/app/output_staging.hpp"
+#include "app/io/bounded_read.hpp"
+#include "app/io/mesh_io.hpp"
+#include "app/io/output_staging.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/config.hpp"
 #include "asperity/core/parallel_errors.hpp"

@@ -10,7 +10,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "asperity/app/mesh_io.hpp"
+#include "app/io/mesh_io.hpp"
 #include "asperity/core/body_impact.hpp"
 #include "asperity/core/mesh.hpp"
 #include "asperity/core/random.hpp"

@@ -12,7 +12,7 @@
 #include <numbers>
 
 #include "asperity/app/experiment_reports.hpp"
-#include "asperity/app/mesh_io.hpp"
+#include "app/io/mesh_io.hpp"
 #include "asperity/core/body.hpp"
 #include "asperity/experiments/body_experiments.hpp"
 #include "asperity/core/mesh.hpp"

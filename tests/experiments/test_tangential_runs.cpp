@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <string>
 
-#include "asperity/app/mesh_io.hpp"
+#include "app/io/mesh_io.hpp"
 #include "asperity/app/scene_file.hpp"
 #include "asperity/experiments/body_bounce.hpp"
 #include "asperity/experiments/body_experiments.hpp"

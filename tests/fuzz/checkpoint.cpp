@@ -19,7 +19,7 @@
 #include <string>
 
 #include "../checkpoint_fixture.hpp"
-#include "asperity/app/checkpoint.hpp"
+#include "app/checkpoint.hpp"
 
 namespace {
 

@@ -15,7 +15,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "asperity/app/mesh_io.hpp"
+#include "app/io/mesh_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1 || size > 4096) return 0;

@@ -10,7 +10,6 @@
 
 #include "asperity/experiments/ensemble.hpp"
 #include "asperity/app/plan.hpp"
-#include "asperity/app/atomic_file.hpp"  // write_file_atomic, before it had a header of its own
 #include "asperity/app/scene.hpp"
 #include "asperity/laws/family.hpp"
 #include "asperity/laws/statistics.hpp"

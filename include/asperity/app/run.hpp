@@ -8,12 +8,13 @@
 #include <vector>
 
 #include "asperity/experiments/ensemble.hpp"
-#include "asperity/app/collective.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/app/scene.hpp"
 
 namespace asperity {
+
+class Collective;  // the processes of a run split across machines (validate-geometry under mpirun)
 
 /// A sphere run (RunKind::sphere) of its plan: only the stages it lists (figures are written into
 /// `dir`, default the scene's out, when planned; the report file is not written). The report

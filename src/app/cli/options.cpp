@@ -16,7 +16,7 @@
 #include <variant>
 #include <vector>
 
-#include "asperity/app/option_table.hpp"
+#include "app/option_table.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene_file.hpp"

@@ -4,7 +4,7 @@
 // "beyond one machine". Only the executable knows MPI; the libraries see a Collective.
 #include <memory>
 
-#include "asperity/app/collective.hpp"
+#include "app/collective.hpp"
 
 namespace asperity::cli {
 

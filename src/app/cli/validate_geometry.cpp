@@ -21,20 +21,20 @@
 #include <string>
 #include <vector>
 
-#include "asperity/app/checkpoint.hpp"
-#include "asperity/app/interrupt.hpp"
-#include "asperity/app/output_staging.hpp"
+#include "app/checkpoint.hpp"
+#include "app/io/interrupt.hpp"
+#include "app/io/output_staging.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/plot.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/app/resources.hpp"
 #include "asperity/app/run.hpp"
 #include "asperity/app/scene.hpp"
-#include "asperity/app/stream_report.hpp"
+#include "app/stream_report.hpp"
 #include "app/cli/options.hpp"
 #include "app/cli/processes.hpp"
 #include "app/cli/progress_line.hpp"
-#include "app/text_escape.hpp"
+#include "app/io/text_escape.hpp"
 
 namespace fs = std::filesystem;
 using namespace asperity;

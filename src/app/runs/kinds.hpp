@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "asperity/app/collective.hpp"
+#include "app/collective.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/app/run.hpp"

@@ -8,7 +8,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "asperity/app/mesh_io.hpp"
+#include "app/io/mesh_io.hpp"
 #include "asperity/app/resources.hpp"
 #include "asperity/core/geometry.hpp"
 #include "asperity/experiments/body_experiments.hpp"

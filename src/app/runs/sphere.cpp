@@ -11,7 +11,7 @@
 #include "asperity/app/plot.hpp"
 #include "asperity/app/resources.hpp"
 #include "asperity/app/scene_file.hpp"
-#include "asperity/app/stream_report.hpp"
+#include "app/stream_report.hpp"
 #include "asperity/config.hpp"
 #include "asperity/experiments/streaming.hpp"
 #include "app/runs/kinds.hpp"

@@ -12,7 +12,7 @@
 #include <string_view>
 #include <vector>
 
-#include "asperity/app/interrupt.hpp"
+#include "app/io/interrupt.hpp"
 
 namespace asperity {
 

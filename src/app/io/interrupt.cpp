@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "asperity/app/interrupt.hpp"
+#include "app/io/interrupt.hpp"
 
 #include <fcntl.h>
 #include <limits.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "asperity/app/bounded_read.hpp"
+#include "app/io/bounded_read.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>

@@ -21,13 +21,11 @@
 #include <string>
 #include <string_view>
 
+#include "app/io/checkpoint_names.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/experiments/streaming.hpp"
 
 namespace asperity {
-
-inline constexpr const char* kCheckpointScene = "checkpoint.toml";
-inline constexpr const char* kCheckpointState = "checkpoint.bin";
 
 /// What must match between a checkpoint and the run that continues it: the scene as given, as TOML
 /// with the fields that change no result (threads, plots, out) cleared, and the design the plan
@@ -36,10 +34,6 @@ std::string checkpoint_key(const Plan& p);
 
 /// The state file of a share: checkpoint.bin for one process, checkpoint.rank-R-of-P.bin otherwise.
 std::string checkpoint_state_name(const StreamShare& share);
-
-/// Whether `name` is a checkpoint file's name (checkpoint.toml, checkpoint.bin,
-/// checkpoint.rank-R-of-P.bin): output_name_problem refuses such names for outputs.
-bool is_checkpoint_name(std::string_view name);
 
 /// Writes the scene (rank 0 only) and p.control.share's state into `dir`. Throws std::runtime_error naming
 /// the file; then `dir` holds the previous complete checkpoint, or none.

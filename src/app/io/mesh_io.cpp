@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // The only CGAL mesh headers of the project: reading and checking triangle meshes.
-#include "asperity/app/mesh_io.hpp"
+#include "app/io/mesh_io.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Polygon_mesh_processing/IO/polygon_mesh_io.h>
@@ -19,10 +19,10 @@
 #include <stdexcept>
 #include <vector>
 
-#include "asperity/app/atomic_file.hpp"
-#include "asperity/app/bounded_read.hpp"
+#include "app/io/atomic_file.hpp"
+#include "app/io/bounded_read.hpp"
 #include "core/format.hpp"
-#include "text_escape.hpp"
+#include "app/io/text_escape.hpp"
 
 namespace asperity {
 

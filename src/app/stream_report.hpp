@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "asperity/app/collective.hpp"
+#include "app/collective.hpp"
 #include "asperity/app/plan.hpp"
 #include "asperity/app/report.hpp"
 #include "asperity/experiments/streaming.hpp"

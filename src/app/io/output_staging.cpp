@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "asperity/app/output_staging.hpp"
+#include "app/io/output_staging.hpp"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -16,8 +16,8 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "asperity/app/atomic_file.hpp"
-#include "asperity/app/checkpoint.hpp"
+#include "app/io/atomic_file.hpp"
+#include "app/io/checkpoint_names.hpp"
 
 namespace asperity {
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
-#include "asperity/app/atomic_file.hpp"
+#include "app/io/atomic_file.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "asperity/app/interrupt.hpp"
+#include "app/io/interrupt.hpp"
 
 namespace asperity {
 
