@@ -105,8 +105,9 @@ void plan_sphere(Plan& p) {
   plan_analysis(p);
 }
 
-// Measured per drop of a fixed sphere: contact samples + the rotation.
-constexpr double kPerDropFixed = 57;
+// Measured per drop of explicit spheres: contact samples + the rotation (fig3-fixed at 2.5e5, 5e5,
+// 1e6, 2e6 drops: 40-46 B per drop between sizes; 57 before, which put fig3-fixed at 1.21x).
+constexpr double kPerDropFixed = 46;
 
 // The cross-check of one sphere (ensemble.cpp cross_check_sphere) while the run's index lives: a
 // kd-tree over the same centres unless it is the backend, and FCL's tree for small N (measured:
@@ -145,8 +146,14 @@ double explicit_spheres_bytes(const Plan& p, std::ostringstream& d) {
   const int threads = threads_of(p.given);
   const double concurrent = pe.spheres <= 1 ? 1.0 : double(std::min<std::uint64_t>(std::uint64_t(threads), pe.spheres));
   const double b = bytes_per_asperity(pe.backend);
-  const double check = pe.spheres <= 1 ? one_sphere_check(pe.backend, N)
-                       : pe.backend == Backend::kdtree ? 0.0 : bytes_per_asperity(Backend::kdtree);
+  // K > 1: the checked sphere's kd-tree (with its own centres) and, for small N, FCL's tree
+  // (cross_check_backends; measured: example.toml at N = 20000 peaks 9.4 MB above N = 20001).
+  double check = pe.spheres <= 1 ? one_sphere_check(pe.backend, N)
+                 : pe.backend == Backend::kdtree ? 0.0 : bytes_per_asperity(Backend::kdtree);
+#if ASPERITY_WITH_FCL
+  if (pe.spheres > 1 && pe.backend != Backend::fcl && N <= double(kCrossCheckFclMax))
+    check += bytes_per_asperity(Backend::fcl) - bytes_per_asperity(Backend::brute);
+#endif
   d << " + " << fmt3(concurrent) << " sphere(s) at once (--threads " << threads << ") x " << pe.sphere.asperities
     << " asperities x " << b << " B (" << to_string(pe.backend) << ")";
   return concurrent * N * b + N * check;
