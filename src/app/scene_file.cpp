@@ -4,6 +4,7 @@
 
 #include "app/io/bounded_read.hpp"
 #include "app/io/output_staging.hpp"
+#include "asperity/app/plan.hpp"  // run_kind: the kinds table's recognition (app/runs/kinds.hpp)
 #include "asperity/app/plot.hpp"
 #include "app/io/text_escape.hpp"
 
@@ -802,6 +803,36 @@ void read_outputs(Reader& top, Scene& s, bool impacts) {
   out->finish();
 }
 
+// The [ensemble] keys a kind of run never uses are refused, never ignored (an option that edits
+// one is named before it): a bounce counts experiment.sequences, not drops, and the sphere's
+// bounce variants build a lazy sphere per sequence (no mode, spheres, backend); only explicit
+// sphere drops run the drop kernel; only sphere contact runs stream; unequal radii on a sphere
+// screen screening.bodies, not spheres. The one statement of these rules (the CLI has none).
+void check_unused_ensemble_keys(const Reader& top, const toml::table& root, const Scene& s) {
+  const RunKind kind = run_kind(s);
+  if (kind == RunKind::sphere) return;
+  std::vector<std::string_view> unused{"kernel", "statistics", "bins_log2"};
+  if (kind == RunKind::bounce || kind == RunKind::mesh_bounce) unused.push_back("drops");
+  if (kind == RunKind::bounce) unused.insert(unused.end(), {"mode", "spheres", "backend"});
+  if (kind == RunKind::radii) unused.push_back("spheres");
+  const std::string what = kind == RunKind::bounce        ? "a bounce run (experiment.kind = \"bounce\")"
+                           : kind == RunKind::mesh_bounce ? "a mesh body's bounce run"
+                           : kind == RunKind::mesh        ? "a mesh body (body.kind = \"mesh\")"
+                                                          : "a run with unequal asperity radii on a sphere";
+  for (const std::string_view k : unused) {
+    const std::string key = "ensemble." + std::string(k);
+    const toml::node* at = root.at_path(key).node();
+    if (!at) continue;
+    std::string why = "not used by " + what;
+    if (k == "drops") why += ", which counts bounce sequences: use experiment.sequences";
+    else if (k == "spheres" && kind == RunKind::radii) why += " (its explicit spheres are screening.bodies)";
+    else if (k == "kernel") why += " (explicit sphere drops only)";
+    else if (k == "statistics" || k == "bins_log2") why += " (sphere contact runs only)";
+    else if (kind == RunKind::bounce) why += ": every sequence bounces its own lazy sphere";
+    top.fail(at, key, key + ": " + why);
+  }
+}
+
 // The engine's own checks, as a net: the keys read above should already have caught everything.
 // A message that starts with a dotted key ("ensemble.drops (--drops): ...") points at its line.
 void validate_at_lines(const Reader& top, const toml::table& root, const Scene& s) {
@@ -831,6 +862,7 @@ Scene scene_from_toml(const toml::table& root, std::string_view origin) {
   check_experiment(top, s, impacts);
   read_outputs(top, s, impacts);
   top.finish();
+  check_unused_ensemble_keys(top, root, s);
   validate_at_lines(top, root, s);
   return s;
 }
@@ -1114,12 +1146,15 @@ void write_asperities(std::ostream& os, const Scene& s) {
     os << "[screening]\nbodies = " << s.radii->screen_bodies << "\ndirections = " << s.radii->screen_directions << "\n\n";
 }
 
+// Only the keys the kind uses (check_unused_ensemble_keys): a sphere's bounce run has its seed and
+// threads; a mesh body's bounce no drops.
 void write_ensemble(std::ostream& os, const Scene& s) {
   const auto& e = s.ensemble;
-  // A scene that named a mode by its earlier name is written as it was named (it runs as explicit).
-  os << "[ensemble]\nmode = \"" << to_string(e.mode)
-     << "\"\ndrops = " << e.drops << "\n";
-  if (e.mode == Mode::explicit_spheres) {  // sampled drops have no explicit spheres
+  const RunKind kind = run_kind(s);
+  os << "[ensemble]\n";
+  if (kind != RunKind::bounce) os << "mode = \"" << to_string(e.mode) << "\"\n";
+  if (kind != RunKind::bounce && kind != RunKind::mesh_bounce) os << "drops = " << e.drops << "\n";
+  if (e.mode == Mode::explicit_spheres && kind != RunKind::bounce) {  // sampled drops have no explicit spheres
     if (s.spheres_auto)
       os << "spheres = \"auto\"\n";
     else
@@ -1130,8 +1165,10 @@ void write_ensemble(std::ostream& os, const Scene& s) {
     os << quote(std::to_string(e.seed));
   else
     os << e.seed;
-  os << "\nbackend = \"" << (s.backend_auto || e.mode == Mode::sampled ? std::string_view("auto") : to_string(e.backend)) << "\"\nthreads = "
-     << e.threads << "\n";
+  os << "\n";
+  if (kind != RunKind::bounce)
+    os << "backend = \"" << (s.backend_auto || e.mode == Mode::sampled ? std::string_view("auto") : to_string(e.backend)) << "\"\n";
+  os << "threads = " << e.threads << "\n";
   if (e.statistics != Statistics::automatic) os << "statistics = \"" << to_string(e.statistics) << "\"\n";
   if (e.bins_log2 != EnsembleConfig{}.bins_log2) os << "bins_log2 = " << e.bins_log2 << "\n";
   if (e.mode == Mode::explicit_spheres && e.kernel != EnsembleConfig{}.kernel)

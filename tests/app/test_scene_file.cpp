@@ -532,8 +532,25 @@ TEST(SceneFileBodies, MeshBounceScenes) {
 }
 
 // Sec. V groups are scene-selectable (issue 15); the defaults stay those of BounceExperiment.
+// A scene text without the [ensemble] keys a sphere's bounce run refuses (it takes seed and threads).
+std::string bounce_ensemble(std::string text) {
+  std::string out;
+  for (std::size_t pos = 0; pos < text.size();) {
+    const std::size_t end = std::min(text.find('\n', pos), text.size());
+    const std::string line = text.substr(pos, end - pos);
+    bool drop = false;
+    for (const char* k : {"mode =", "drops =", "spheres =", "backend =", "kernel ="}) drop |= line.rfind(k, 0) == 0;
+    if (!drop) out += line + "\n";
+    pos = end + 1;
+  }
+  return out;
+}
+
 TEST(SceneFile, BounceGroupsAreSelectable) {
-  const std::string base = replace(kGood, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"bounce\"\nsequences = 20");
+  const std::string base = bounce_ensemble(
+      replace(kGood, "kind = \"impact\"\nV = [0.0, 0.0, -1.3]\nOmega = [0.2, 0.0, 0.0]", "kind = \"bounce\"\nsequences = 20"));
+  // The keys it never uses are refused, never ignored (issue 43): drops counts nothing in a bounce.
+  expect_error(replace(base, "seed = ", "drops = 100\nseed = "), "ensemble.drops", "experiment.sequences");
   const Scene d = parse_scene(base);
   EXPECT_EQ(d.bounce.windows, BounceExperiment{}.windows);
   EXPECT_EQ(d.bounce.impact_numbers, BounceExperiment{}.impact_numbers);

@@ -104,8 +104,9 @@ SCENES = {
     "backend-x": FIG3.replace('backend = "auto"', 'backend = "x"'),
     "eps_t-2": FIG3.replace("eps_t = 1.0", "eps_t = 2.0"),
     "unknown-key": FIG3.replace("seed = 1", "seed = 1\nseeds = 2"),
-    # drops given in the file of a bounce run (accepted at 3dfd20f, while --drops is refused); small, as it may run
-    "fig6-drops": FIG6.replace("count = 1000000", "count = 2000").replace("sequences = 100000", "sequences = 20"),
+    # drops given in the file of a bounce run: refused as --drops is (accepted at 3dfd20f); small, as it may run
+    "fig6-drops": FIG6.replace("count = 1000000", "count = 2000").replace("sequences = 100000", "sequences = 20")
+                      .replace("seed = 1", "drops = 1000000\nseed = 1"),
 }
 
 # Every option with a bad value (and a few rules that depend on the kind of run).

@@ -199,15 +199,6 @@ OptionKind option_kind(const Scene& scene) {
   return k;
 }
 
-// --drops, --mode, --spheres, --kernel on the kinds of run they do not apply to (their values: the reader).
-void refuse_design_options(const Given& given, const OptionKind& k) {
-  if (given("--drops") && k.bounce) refuse("--drops", "not used by " + k.text + ", which counts bounce sequences: use --sequences");
-  if (given("--mode") && k.bounce) refuse("--mode", "not used by " + k.text + ": every sequence bounces its own sphere");
-  if (given("--spheres") && ((k.bounce && !k.mesh) || k.radii))
-    refuse("--spheres", "not used by " + k.text + (k.radii ? " (its explicit spheres are screening.bodies of the scene file)" : ""));
-  if (given("--kernel") && (k.bounce || k.mesh || k.radii)) refuse("--kernel", "not used by " + k.text + " (explicit sphere drops only)");
-}
-
 // --speed, --omega-x, --omega-y: the impact (a mesh body's bounce takes the spin as its start).
 void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given, const OptionKind& k) {
   auto& e = scene.ensemble;
@@ -231,15 +222,6 @@ void apply_impact_options(Scene& scene, const RawOptions& r, const Given& given,
   if (k.radii) refuse(opt, k.text + " is analysed as contacts only (no impacts)");
   if (!e.impact.enabled && !(k.bounce && k.mesh))
     refuse("--omega-x/--omega-y", "need an impact: give --speed or a preset with impacts (fig4, fig5)");
-}
-
-void apply_backend_option(const Scene& scene, const OptionKind& k) {
-  const auto& e = scene.ensemble;
-  if (k.bounce || k.mesh || k.radii)
-    refuse("--backend", "not used by " + k.text + (k.bounce ? "" : ", which queries the exact support tree"));
-  if (e.mode != Mode::explicit_spheres)
-    refuse("--backend", "only for the explicit design (explicit spheres); sampled drops query no index (the lowest "
-                        "asperities are drawn from the exact law): add --mode explicit");
 }
 
 // --speed as the bounce's first speed.
@@ -277,15 +259,12 @@ void apply_tangential_option(Scene& scene, const RawOptions& r, const OptionKind
   scene.bounce.eps_t = x.eps_t;
 }
 
-// --statistics, --bins-log2 (sphere contact runs), --checkpoint-every (streaming runs).
-void apply_streaming_options(RunControl& control, const RawOptions& r, const Given& given, const OptionKind& k) {
-  if (given("--checkpoint-every")) {
-    control.checkpoint_seconds = parse_real("--checkpoint-every", r["--checkpoint-every"]);
-    if (!(control.checkpoint_seconds >= 0) || !std::isfinite(control.checkpoint_seconds))
-      throw BadInput("--checkpoint-every: '" + r["--checkpoint-every"] + "' must be a finite number of seconds >= 0");
-  }
-  if ((given("--statistics") || given("--bins-log2")) && (k.bounce || k.mesh || k.radii))
-    refuse(given("--statistics") ? "--statistics" : "--bins-log2", "not used by " + k.text + " (sphere contact runs only)");
+// --checkpoint-every (streaming runs): run control, not scene data.
+void apply_checkpoint_option(RunControl& control, const RawOptions& r, const Given& given) {
+  if (!given("--checkpoint-every")) return;
+  control.checkpoint_seconds = parse_real("--checkpoint-every", r["--checkpoint-every"]);
+  if (!(control.checkpoint_seconds >= 0) || !std::isfinite(control.checkpoint_seconds))
+    throw BadInput("--checkpoint-every: '" + r["--checkpoint-every"] + "' must be a finite number of seconds >= 0");
 }
 
 // --resume DIR: the checkpoint's own scene; only options that change no result (their rows) may
@@ -359,12 +338,10 @@ Scene scene_with_options(const RawOptions& r, const Given& given, const SceneLoa
                                                                                         : load_scene(path, edits);
   if (given("--resume")) scene.out = r["--resume"], control.resume = true;
   const OptionKind k = option_kind(scene);
-  refuse_design_options(given, k);
   apply_impact_options(scene, r, given, k);
-  if (given("--backend")) apply_backend_option(scene, k);
   apply_bounce_options(scene, given);
   if (given("--tangential")) apply_tangential_option(scene, r, k);
-  apply_streaming_options(control, r, given, k);
+  apply_checkpoint_option(control, r, given);
   apply_run_options(scene, r, given);
   return scene;  // the cross-key rules: plan() (plan.hpp), once per run
 }
