@@ -30,4 +30,12 @@ set_tests_properties(
   # sampled streaming run cut and resumed, CheckpointTrust.EveryStreamingRunResumesToTheSameBits;
   # SIGTERM and --resume through the CLI, Checkpoint.SigtermThenResumeEqualsTheUninterruptedRun
   Checkpoint.AnImpactSceneWithoutRestitutionStreamsCompletesAndResumes
+  # the comparison's power against three wrong rotations of 20 random bodies (FreeRotation and the
+  # odeint reference on the same bodies): FreeRotation.MatchesOdeintReferenceForRandomBodies
+  FreeRotation.ComparisonRejectsWrongImplementations
+  # the grid against brute force at N = 10^5 (the same code at N = 1 ... 1000):
+  # Sizes/GridRandom.MatchesBruteOnRandomQueries/1, /2, /3, /10, /1000
+  Sizes/GridRandom.MatchesBruteOnRandomQueries/100000
+  # the level sampler's law and power against a wrong law: TheoryRadii.FreshSamplerEqualsExplicitBodies
+  TheoryRadii.FreshSamplerFollowsTheExactLawAndAWrongLawIsRejected
   PROPERTIES LABELS no-sanitizer)
