@@ -10,14 +10,25 @@
 
 namespace asperity {
 
+namespace {
+
+// Whether a run of p writes a file (figures, a restitution table, a mesh body's PLY): one that
+// writes none needs no staging directory, and touches no directory at all (asperity.run, out=None).
+bool writes_files(const Plan& p) {
+  const Scene& s = p.scene;
+  return s.plots || s.cor_table || (s.mesh && !s.mesh->export_ply.empty());
+}
+
+}  // namespace
+
 SceneOutput run_plan(const Plan& p, const Progress& progress, std::ostream* log, const std::filesystem::path& dir,
                      Collective* group, ContactSamples* keep) {
   const ThreadCountScope thread_scope(p.scene.ensemble.threads);  // for this call only (core/thread_count.hpp)
   // Without a directory from the caller the run stages its own files in out and renames them
   // into place at the end: a failure leaves out as it was (output_staging.hpp).
   std::optional<OutputStaging> own;
-  if (dir.empty()) own.emplace(p.scene.out);
-  const std::filesystem::path& into = dir.empty() ? own->dir() : dir;
+  if (dir.empty() && writes_files(p)) own.emplace(p.scene.out);
+  const std::filesystem::path into = own ? own->dir() : dir;
   SceneOutput o = runs::kind(p.kind).run(p, {progress, log, into, group, keep});
   o.kind = p.kind;
   if (own) {

@@ -334,21 +334,6 @@ py::dict samples_to_dict(ContactSamples&& s) {
   return d;
 }
 
-// A private directory in the system's temporary folder, removed with everything in it when the
-// call ends: where a run that writes no files stages nothing (run_scene_output needs a directory).
-struct PrivateDir {
-  std::filesystem::path path;
-  PrivateDir() {
-    std::string t = (std::filesystem::temp_directory_path() / "asperity-run-XXXXXX").string();
-    if (::mkdtemp(t.data()) == nullptr) throw std::runtime_error("cannot create a temporary directory " + t);
-    path = t;
-  }
-  ~PrivateDir() {
-    std::error_code ec;
-    std::filesystem::remove_all(path, ec);
-  }
-};
-
 // Where asperity.run may write (out=): None (the default) writes no file at all -- no figures, no
 // checkpoints -- and refuses a scene whose outputs are files (a notebook must not litter its working
 // directory); a path writes the scene's outputs there; True writes them to the scene's outputs.dir.
@@ -374,7 +359,7 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
   check_callable(progress);
   Scene scene = to_scene(scene_arg);
   RunControl control;
-  const bool files = apply_out(scene, control, out_arg);
+  apply_out(scene, control, out_arg);
   bool arrays = false;
   if (arrays_arg.is_none())
     arrays = run_kind(scene) == RunKind::sphere && scene.ensemble.drops <= max_array_drops;
@@ -395,13 +380,12 @@ py::object run(const py::handle& scene_arg, const py::object& progress, const py
   const Progress p = python_progress(progress);
   SceneOutput out;
   ContactSamples samples;
-  std::optional<PrivateDir> scratch;
-  if (!files) scratch.emplace();
   {
     py::gil_scoped_release nogil;
     // The arrays are the run's own drops; a streaming run keeps none, so its arrays come from the
     // same drops again, bit-identical (every drop is a pure function of seed and index).
-    out = run_plan(planned, p, nullptr, files ? std::filesystem::path() : scratch->path, nullptr,
+    // out=None: the plan writes no file (apply_out), so run_plan touches no directory.
+    out = run_plan(planned, p, nullptr, {}, nullptr,
                    arrays && !planned.streams ? &samples : nullptr);
     if (arrays && planned.streams) samples = run_contact_ensemble(planned.scene.ensemble, p);
   }

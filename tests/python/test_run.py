@@ -193,8 +193,13 @@ def test_run_writes_no_file_unless_asked(small_scene, tmp_path, monkeypatch):
     scene["ensemble"].update(drops=4000, spheres=4)
     scene["outputs"].update(plots=True, dir=str(tmp_path / "scene-dir"))
     before = sorted(os.listdir(tmp_path))
-    r = asperity.run(scene, arrays=False)
-    assert sorted(os.listdir(tmp_path)) == before and r["plots"] == []
+    scratch = tmp_path / "tmp"  # issue 43: no scratch directory either (TMPDIR stays empty)
+    scratch.mkdir()
+    monkeypatch.setenv("TMPDIR", str(scratch))
+    seen = []  # TMPDIR while the run computes (a scratch directory would be there, then removed)
+    r = asperity.run(scene, arrays=False, progress=lambda done, total: seen.append(os.listdir(scratch)))
+    assert sorted(os.listdir(tmp_path)) == sorted(before + ["tmp"]) and r["plots"] == []
+    assert seen and all(listing == [] for listing in seen), seen
     out = tmp_path / "figs"
     r = asperity.run(scene, arrays=False, out=out)
     assert r["plots"] and all((out / f).is_file() for f in r["plots"] + r["plot_data"])

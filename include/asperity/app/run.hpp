@@ -45,7 +45,8 @@ struct SceneOutput {
 /// (sphere, radii, mesh), one line per bounce variant to `log` if given.
 /// `dir` given (validate-geometry: an OutputStaging's dir()): the files are written there under
 /// their final names and the caller commits them. `dir` empty: they are staged in the scene's out
-/// and renamed into place when the run succeeded; on an exception out is left as it was.
+/// and renamed into place when the run succeeded; on an exception out is left as it was. A run
+/// that writes no file (no figures, restitution table or PLY export) touches no directory.
 /// `group`, `keep`: as run_scene (only streaming sphere runs are split; others run on rank 0 alone).
 SceneOutput run_plan(const Plan& p, const Progress& progress = {}, std::ostream* log = nullptr,
                      const std::filesystem::path& dir = {}, Collective* group = nullptr,
