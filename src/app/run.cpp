@@ -14,10 +14,7 @@ namespace {
 
 // Whether a run of p writes a file (figures, a restitution table, a mesh body's PLY): one that
 // writes none needs no staging directory, and touches no directory at all (asperity.run, out=None).
-bool writes_files(const Plan& p) {
-  const Scene& s = p.scene;
-  return s.plots || s.cor_table || (s.mesh && !s.mesh->export_ply.empty());
-}
+bool writes_files(const Plan& p) { return p.scene.plots || !file_output_key(p.scene).empty(); }
 
 }  // namespace
 

@@ -71,6 +71,12 @@ std::string report_table_name(const std::string& report) {
   return txt.string();
 }
 
+std::string file_output_key(const Scene& s) {
+  if (s.cor_table) return "outputs.cor_table";
+  if (s.mesh && !s.mesh->export_ply.empty()) return "outputs.export_ply";
+  return {};
+}
+
 std::string cor_table_header_name(const std::string& csv) {
   return std::filesystem::path(csv).replace_extension(".json").string();
 }

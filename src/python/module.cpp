@@ -340,9 +340,8 @@ py::dict samples_to_dict(ContactSamples&& s) {
 // Returns whether files are written.
 bool apply_out(Scene& scene, RunControl& control, const py::object& out) {
   if (out.is_none() || (py::isinstance<py::bool_>(out) && !out.cast<bool>())) {
-    const char* file_output = scene.cor_table ? "outputs.cor_table" : scene.mesh && !scene.mesh->export_ply.empty() ? "body.export_ply" : nullptr;
-    if (file_output)
-      value_error(std::string("out: the scene's ") + file_output + " writes a file; pass out=DIR (or out=True for the scene's outputs.dir)");
+    if (const std::string key = file_output_key(scene); !key.empty())
+      value_error("out: the scene's " + key + " writes a file; pass out=DIR (or out=True for the scene's outputs.dir)");
     scene.plots = false;
     control.checkpoint_seconds = 0;  // no signal handler in Python: never written
     return false;

@@ -210,6 +210,10 @@ def test_run_writes_no_file_unless_asked(small_scene, tmp_path, monkeypatch):
     table["outputs"]["cor_table"] = {"file": "t.csv"}
     with pytest.raises(ValueError, match="out="):
         asperity.run(table)
+    # A mesh body's PLY export is named by its scene key (it said "body.export_ply", a key no reader has).
+    ellipsoid = os.path.join(os.path.dirname(__file__), "..", "..", "scenes", "ellipsoid.toml")
+    with pytest.raises(ValueError, match=r"outputs\.export_ply writes a file"):
+        asperity.run(ellipsoid)
     with pytest.raises(TypeError, match="out"):
         asperity.run(scene, out=3)
 

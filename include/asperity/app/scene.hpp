@@ -117,6 +117,11 @@ Scene preset(std::string_view name);
 /// (report_table_name) and from the figures and their data (*.png, *.svg, *.pdf, *.csv).
 void validate(const Scene& s);
 
+/// The key of an output the scene writes as a file besides its figures ("outputs.cor_table",
+/// "outputs.export_ply"), empty when it writes none: the one answer for run_plan (whether it
+/// stages files) and asperity.run (which refuses such a scene without out=).
+std::string file_output_key(const Scene& s);
+
 /// The table's file name next to the report: its name with .txt ("report.json" -> "report.txt";
 /// "x.txt" -> "x.txt.txt").
 std::string report_table_name(const std::string& report);
